@@ -1,0 +1,1 @@
+//! Scanline assembly (SPEC §2). SKELETON: filled in by issue 2.

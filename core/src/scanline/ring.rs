@@ -1,0 +1,1 @@
+//! A fixed-capacity byte ring. SKELETON: filled in by issue 2.
