@@ -19,4 +19,6 @@
 //! | `simulate` | the scene simulator |
 //! | `plot` | pictures |
 
+pub mod bend;
+pub mod io;
 pub mod model;

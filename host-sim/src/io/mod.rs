@@ -1,0 +1,3 @@
+//! Input and output: LAS/LAZ point columns, the trajectory CSV, output writers.
+
+pub mod trajectory;
