@@ -119,6 +119,11 @@ impl PointGrid {
     pub fn len(&self) -> usize {
         self.order.len()
     }
+
+    /// Whether no point is indexed.
+    pub fn is_empty(&self) -> bool {
+        self.order.is_empty()
+    }
 }
 
 #[cfg(test)]

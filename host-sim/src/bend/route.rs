@@ -45,9 +45,9 @@ impl Route {
         // Keep a vertex every DECIMATE_M (and the last one) for the nearest-point index.
         let mut keep = vec![false; n];
         let mut last_s = f64::NEG_INFINITY;
-        for k in 0..n {
+        for (k, kept) in keep.iter_mut().enumerate() {
             if r.s[k] - last_s >= DECIMATE_M || k + 1 == n {
-                keep[k] = true;
+                *kept = true;
                 last_s = r.s[k];
             }
         }
@@ -65,7 +65,11 @@ impl Route {
         }
         let k = self.t.partition_point(|&u| u <= t).clamp(1, n - 1);
         let (a, b) = (self.t[k - 1], self.t[k]);
-        let w = if b > a { ((t - a) / (b - a)).clamp(0.0, 1.0) } else { 0.0 };
+        let w = if b > a {
+            ((t - a) / (b - a)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         Some((k - 1, w))
     }
 
@@ -112,8 +116,14 @@ impl Route {
         let (_, k0) = best?;
         // Refine on the original segments around it (±DECIMATE_M worth of samples).
         let s0 = self.s[k0];
-        let lo = self.s.partition_point(|&s| s < s0 - 2.0 * DECIMATE_M).saturating_sub(1);
-        let hi = self.s.partition_point(|&s| s <= s0 + 2.0 * DECIMATE_M).min(self.s.len() - 1);
+        let lo = self
+            .s
+            .partition_point(|&s| s < s0 - 2.0 * DECIMATE_M)
+            .saturating_sub(1);
+        let hi = self
+            .s
+            .partition_point(|&s| s <= s0 + 2.0 * DECIMATE_M)
+            .min(self.s.len() - 1);
         let mut best_p = ([self.x[k0], self.y[k0]], f64::INFINITY, k0);
         for k in lo..=hi {
             let seg_end = (k + 1).min(hi);

@@ -215,7 +215,11 @@ mod tests {
         let mut y = Vec::new();
         for k in 0..30 {
             let xx = k as f64 * 0.1;
-            let off = if k % 3 == 1 { 0.3 + 0.03 * k as f64 } else { 0.0 };
+            let off = if k % 3 == 1 {
+                0.3 + 0.03 * k as f64
+            } else {
+                0.0
+            };
             x.push(600_000.0 + xx);
             y.push(4_000_000.0 + 0.5 * xx + 3.0 + off);
         }
@@ -253,8 +257,12 @@ mod tests {
     #[test]
     fn too_few_inliers_give_no_seed() {
         // Points scattered on a circle of radius 1 m: no three collinear within 40 mm.
-        let x: Vec<f64> = (0..12).map(|k| (k as f64 * 0.5236).cos()).collect();
-        let y: Vec<f64> = (0..12).map(|k| (k as f64 * 0.5236).sin()).collect();
+        let x: Vec<f64> = (0..12)
+            .map(|k| (k as f64 * std::f64::consts::FRAC_PI_6).cos())
+            .collect();
+        let y: Vec<f64> = (0..12)
+            .map(|k| (k as f64 * std::f64::consts::FRAC_PI_6).sin())
+            .collect();
         let pts: Vec<u32> = (0..12).collect();
         assert_eq!(ransac_line(&x, &y, &pts, &BendParams::default(), 1), None);
     }
