@@ -560,7 +560,7 @@ mod tests {
         let s = stream(2, 40, 20); // config 80 B + 4 packets of 424 B
         const R: usize = 1500;
         let expected = [(0, 0, 40, 0), (1, 40, 40, 0)];
-        for offset in (0..R).step_by(7).chain(R - 30..R) {
+        for offset in 0..R {
             for piece in [1usize, 3, 13, 424, 1499] {
                 let mut ing = Ingest::<R, 64>::new();
                 // Garbage without sync bytes moves the read position to `offset`.
