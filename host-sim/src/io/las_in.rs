@@ -245,19 +245,19 @@ impl PointColumns {
         self.scan_angle_deg.shrink_to_fit();
     }
 
-    /// Keeps the points with `keep[i]` true, in order (used to drop points outside the
-    /// trajectory). In place: no second copy of the columns.
-    pub fn retain_by(&mut self, keep: &[bool]) {
-        fn go<T: Copy>(v: &mut Vec<T>, keep: &[bool]) {
-            let mut k = keep.iter();
-            v.retain(|_| *k.next().unwrap_or(&false));
+    /// Keeps the points `range` (the ones the trajectory covers: contiguous, as the columns
+    /// are sorted by time), in place.
+    pub fn keep_range(&mut self, range: std::ops::Range<usize>) {
+        fn go<T>(v: &mut Vec<T>, r: &std::ops::Range<usize>) {
+            v.truncate(r.end);
+            v.drain(..r.start.min(v.len()));
         }
-        go(&mut self.x, keep);
-        go(&mut self.y, keep);
-        go(&mut self.z, keep);
-        go(&mut self.t, keep);
-        go(&mut self.intensity, keep);
-        go(&mut self.scan_angle_deg, keep);
+        go(&mut self.x, &range);
+        go(&mut self.y, &range);
+        go(&mut self.z, &range);
+        go(&mut self.t, &range);
+        go(&mut self.intensity, &range);
+        go(&mut self.scan_angle_deg, &range);
     }
 
     /// Sorts by time, stably, if not sorted already. Returns true when it reordered.

@@ -16,8 +16,6 @@
 //!    ⌊(t − t₀) / period⌋ = k.
 //! 3. **Neither**: no flags; the core splits lines itself (its no-flag rule, SPEC §2).
 
-use serde::{Deserialize, Serialize};
-
 /// How line starts are derived (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum LineRule {
@@ -40,8 +38,7 @@ pub enum LineRule {
 }
 
 /// The line-start part of the `[replay]` config table.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LineStartParams {
     /// Smallest backward jump of the scan angle taken as the wrap between two lines,
     /// degrees. Consecutive returns of a rotating scanner differ by well under a degree; a
