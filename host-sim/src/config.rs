@@ -11,6 +11,7 @@
 //! A method adds its own table by adding a field with `#[serde(default)]` here (e.g.
 //! `[qiu]`).
 
+use crate::bend::BendParams;
 use crate::replay::run::ReplayParams;
 use curbtrace_core::kernel::{KernelParams, CONFIG_WORDS};
 use serde::{Deserialize, Serialize};
@@ -53,6 +54,8 @@ pub struct Config {
     pub kernel: KernelConfig,
     /// Replay parameters (`[replay]`).
     pub replay: ReplayParams,
+    /// The bend method's seeding, tracking and post-filters (`[bend]`).
+    pub bend: BendParams,
 }
 
 impl Config {
