@@ -23,3 +23,4 @@ pub mod bend;
 pub mod io;
 pub mod model;
 pub mod replay;
+pub mod simulate;
