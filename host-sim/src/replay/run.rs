@@ -34,6 +34,9 @@ pub const RING: usize = 1 << 16;
 /// truncated by the core.
 pub const LINE_CAPACITY: usize = 16_384;
 
+/// Stack size of the threads that run pipelines.
+pub const PIPELINE_STACK: usize = 64 << 20;
+
 /// The host's pipeline type.
 pub type HostPipeline = Pipeline<RING, LINE_CAPACITY>;
 
@@ -343,16 +346,25 @@ pub fn run_kernel(
         }
     }
     let done = std::sync::atomic::AtomicU64::new(0);
-    let outs: Vec<Result<ChunkOut, ReplayError>> = parts
-        .into_par_iter()
-        .map(|(rg, r, s, l)| {
-            let len = rg.len() as u64;
-            let o = run_chunk(cols, rg, traj, words, &rule, r, s, l);
-            let d = done.fetch_add(len, std::sync::atomic::Ordering::Relaxed) + len;
-            progress(d);
-            o
-        })
-        .collect();
+    // A pool of our own: a pipeline holds a few MB of fixed buffers, more than rayon's
+    // default 2 MiB worker stacks take in a debug build.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(rayon::current_num_threads())
+        .stack_size(PIPELINE_STACK)
+        .build()
+        .map_err(|e| ReplayError::Io(std::io::Error::other(e)))?;
+    let outs: Vec<Result<ChunkOut, ReplayError>> = pool.install(|| {
+        parts
+            .into_par_iter()
+            .map(|(rg, r, s, l)| {
+                let len = rg.len() as u64;
+                let o = run_chunk(cols, rg, traj, words, &rule, r, s, l);
+                let d = done.fetch_add(len, std::sync::atomic::Ordering::Relaxed) + len;
+                progress(d);
+                o
+            })
+            .collect()
+    });
     let mut counters = ReplayCounters::default();
     let mut candidates = Vec::new();
     let mut bases = Vec::with_capacity(outs.len());
