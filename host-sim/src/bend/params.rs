@@ -105,6 +105,10 @@ pub struct BendParams {
     /// while a 4 m corner radius moves by under 2 mm over the 0.45 m window. Not in the
     /// paper; 0 turns it off.
     pub smooth_half_window: u32,
+    /// Moves each output vertex to the peak of a parabola through ρ of its point and its
+    /// two neighbours on the same scanline (at most half a point spacing), instead of
+    /// leaving it on the measured point. Not in the paper.
+    pub refine_peak: bool,
 
     // ---- Curb height and category (output properties) ----
     /// Width of the strips on either side of an edge point whose median heights give the
@@ -152,6 +156,7 @@ impl Default for BendParams {
             vehicle_share: 0.3,
             roadway_filter: true,
             smooth_half_window: 2,
+            refine_peak: false,
             step_strip_m: 0.25,
             step_gap_m: 0.08,
             curb_cut_max_step_m: 0.05,

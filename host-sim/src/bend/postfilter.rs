@@ -243,7 +243,17 @@ pub fn to_edge_lines(
 ) -> Vec<EdgeLine> {
     let mut out = Vec::new();
     for t in tracks {
-        let raw: Vec<[f64; 3]> = t.points.iter().map(|&p| pos(input, p)).collect();
+        let raw: Vec<[f64; 3]> = t
+            .points
+            .iter()
+            .map(|&p| {
+                if params.refine_peak {
+                    refined_pos(input, p)
+                } else {
+                    pos(input, p)
+                }
+            })
+            .collect();
         let xy: Vec<[f64; 2]> = raw.iter().map(|p| [p[0], p[1]]).collect();
         let xyz = smooth(&raw, params.smooth_half_window as usize);
         let steps = height_steps(input, grid, route, t, params);
@@ -278,6 +288,40 @@ pub fn to_edge_lines(
         }
     }
     out
+}
+
+/// The position of the ρ peak at point `p`: the vertex of the parabola through ρ of `p`
+/// and its neighbours on the same scanline (adjacent in time order), at most half-way to
+/// a neighbour; `p` itself where that is not defined.
+fn refined_pos(input: &BendInput, p: u32) -> [f64; 3] {
+    let i = p as usize;
+    let here = pos(input, p);
+    if i == 0 || i + 1 >= input.x.len() {
+        return here;
+    }
+    let ok =
+        |j: usize| input.status[j] == super::STATUS_KEPT && input.scanline[j] == input.scanline[i];
+    if !(ok(i - 1) && ok(i + 1)) {
+        return here;
+    }
+    let (r0, r1, r2) = (
+        input.rho_deg[i - 1] as f64,
+        input.rho_deg[i] as f64,
+        input.rho_deg[i + 1] as f64,
+    );
+    let denom = r0 - 2.0 * r1 + r2;
+    if denom >= -1e-9 {
+        return here;
+    }
+    let delta = (0.5 * (r0 - r2) / denom).clamp(-0.5, 0.5);
+    let j = if delta > 0.0 { i + 1 } else { i - 1 };
+    let q = pos(input, j as u32);
+    let w = delta.abs();
+    [
+        here[0] + w * (q[0] - here[0]),
+        here[1] + w * (q[1] - here[1]),
+        here[2] + w * (q[2] - here[2]),
+    ]
 }
 
 /// Moving average over ±`k` vertices, the window shrinking symmetrically at the ends.
@@ -430,6 +474,33 @@ mod tests {
         assert!((s[1][1] - 0.01).abs() < 1e-12 && (s[1][0] - 1.0).abs() < 1e-12);
         assert!((s[2][1] - 0.012).abs() < 1e-12);
         assert_eq!(smooth(&p, 0), p);
+    }
+
+    #[test]
+    fn peak_refinement_moves_to_the_parabola_vertex() {
+        use crate::io::trajectory::Trajectory;
+        // ρ = 60, 90, 80 at x = 0, 0.02, 0.04: parabola vertex at δ = 0.5·(60 − 80)/
+        // (60 − 180 + 80) = 0.25 points towards the third, x = 0.025.
+        let traj = Trajectory::default();
+        let input = BendInput {
+            x: &[0.0, 0.02, 0.04],
+            y: &[0.0; 3],
+            z: &[1.0; 3],
+            t: &[0.0; 3],
+            rho_deg: &[60.0, 90.0, 80.0],
+            status: &[0; 3],
+            scanline: &[4; 3],
+            candidates: &[],
+            trajectory: &traj,
+        };
+        let q = refined_pos(&input, 1);
+        assert!((q[0] - 0.025).abs() < 1e-12, "{q:?}");
+        // Another scanline next door: no refinement.
+        let input = BendInput {
+            scanline: &[4, 4, 5],
+            ..input
+        };
+        assert_eq!(refined_pos(&input, 1), [0.02, 0.0, 1.0]);
     }
 
     #[test]
