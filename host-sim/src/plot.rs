@@ -337,6 +337,134 @@ fn dashes(pts: &[(f64, f64)], dash: f64) -> Vec<Vec<(f64, f64)>> {
     out
 }
 
+/// The point at half the 2D length of a polyline (its first vertex if it has no length).
+fn mid_point(l: &EdgeLine) -> Option<[f64; 2]> {
+    let half = l.length_m() / 2.0;
+    let mut s = 0.0;
+    for w in l.points.windows(2) {
+        let len = (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]);
+        if s + len >= half && len > 0.0 {
+            let t = (half - s) / len;
+            return Some([
+                w[0][0] + t * (w[1][0] - w[0][0]),
+                w[0][1] + t * (w[1][1] - w[0][1]),
+            ]);
+        }
+        s += len;
+    }
+    l.points.first().map(|p| [p[0], p[1]])
+}
+
+/// Unit direction of a line at one end, pointing out of the line (`at_end`: the last
+/// vertex, else the first), from the end vertex and the vertex about 1 m inside.
+fn end_direction(l: &EdgeLine, at_end: bool) -> Option<[f64; 2]> {
+    let pts: Vec<&[f64; 3]> = if at_end {
+        l.points.iter().rev().collect()
+    } else {
+        l.points.iter().collect()
+    };
+    let e = pts.first()?;
+    let inner = pts
+        .iter()
+        .find(|p| (p[0] - e[0]).hypot(p[1] - e[1]) >= 1.0)
+        .or(pts.last())?;
+    let (dx, dy) = (e[0] - inner[0], e[1] - inner[1]);
+    let n = dx.hypot(dy);
+    (n > 0.0).then(|| [dx / n, dy / n])
+}
+
+/// Zoom windows at the places people want to see, found from the reference lines:
+/// the longest curb cut, intersection and bus bay (centred on the middle of the line) and the
+/// longest *occlusion*: a hole of 2–15 m between two free ends (meeting no other line of
+/// their side) of curb or curb-cut lines of one side that continue each other straight
+/// (within 20°), which is where the reference leaves out what the
+/// scanner never saw — usually a parked car. Returns (name, window) pairs; names are
+/// `curb_cut`, `intersection`, `bus_bay`, `occlusion`.
+pub fn windows_of_interest(reference: &[EdgeLine], half_size_m: f64) -> Vec<(String, Window)> {
+    use crate::model::Category;
+    let mut out = Vec::new();
+    for cat in [Category::CurbCut, Category::Intersection, Category::BusBay] {
+        // The longest line of the category shows it best.
+        let best = reference
+            .iter()
+            .filter(|l| l.category == Some(cat))
+            .max_by(|a, b| a.length_m().total_cmp(&b.length_m()));
+        if let Some(c) = best.and_then(mid_point) {
+            out.push((
+                cat.as_str().to_string(),
+                Window {
+                    center: c,
+                    half_size_m,
+                },
+            ));
+        }
+    }
+    let straight = |l: &&EdgeLine| matches!(l.category, Some(Category::Curb | Category::CurbCut));
+    let ends: Vec<(usize, [f64; 2], [f64; 2])> = reference
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| straight(l))
+        .flat_map(|(i, l)| {
+            [false, true].into_iter().filter_map(move |at_end| {
+                let p = if at_end {
+                    l.points.last()
+                } else {
+                    l.points.first()
+                }?;
+                Some((i, [p[0], p[1]], end_direction(l, at_end)?))
+            })
+        })
+        .collect();
+    // An end that meets another line of its side (a curb running on as a curb cut) is no
+    // hole.
+    let meets_another = |i: usize, p: [f64; 2]| {
+        reference.iter().enumerate().any(|(j, l)| {
+            j != i
+                && l.side == reference[i].side
+                && [l.points.first(), l.points.last()]
+                    .into_iter()
+                    .flatten()
+                    .any(|q| (q[0] - p[0]).hypot(q[1] - p[1]) < 0.5)
+        })
+    };
+    let ends: Vec<_> = ends
+        .into_iter()
+        .filter(|&(i, p, _)| !meets_another(i, p))
+        .collect();
+    let cos20 = 20f64.to_radians().cos();
+    let mut hole: Option<(f64, [f64; 2])> = None;
+    for (a, &(ia, pa, da)) in ends.iter().enumerate() {
+        for &(ib, pb, db) in &ends[a + 1..] {
+            if ia == ib || reference[ia].side != reference[ib].side {
+                continue;
+            }
+            let (dx, dy) = (pb[0] - pa[0], pb[1] - pa[1]);
+            let gap = dx.hypot(dy);
+            if !(2.0..=15.0).contains(&gap) {
+                continue;
+            }
+            let (ux, uy) = (dx / gap, dy / gap);
+            // a's end points towards b, b's end points back towards a.
+            if da[0] * ux + da[1] * uy >= cos20
+                && -(db[0] * ux + db[1] * uy) >= cos20
+                && hole.is_none_or(|(g, _)| gap > g)
+            {
+                hole = Some((gap, [pa[0] + dx / 2.0, pa[1] + dy / 2.0]));
+            }
+        }
+    }
+    if let Some((_, c)) = hole {
+        out.push((
+            "occlusion".to_string(),
+            Window {
+                center: c,
+                half_size_m,
+            },
+        ));
+    }
+    out
+}
+
 /// Draws a top view of `view` into the PNG `path` and returns what it drew.
 ///
 /// The picture has equal scale on both axes; its height follows from the view's shape
@@ -943,6 +1071,45 @@ mod tests {
         let d = dashes(&[(0.0, 0.0), (0.5, 0.0), (0.5, 2.0)], 1.0);
         assert_eq!(d[0], vec![(0.0, 0.0), (0.5, 0.0), (0.5, 0.5)]);
         assert_eq!(d[1], vec![(0.5, 1.5), (0.5, 2.0)]);
+    }
+
+    #[test]
+    fn windows_of_interest_find_categories_and_the_occlusion() {
+        let l = |pts: &[(f64, f64)], side, cat| EdgeLine {
+            points: pts.iter().map(|&(x, y)| [x, y, 0.0]).collect(),
+            side,
+            category: Some(cat),
+            method: None,
+            curb_height_m: None,
+        };
+        let refs = vec![
+            l(&[(0.0, 5.0), (40.0, 5.0)], Side::Left, Category::Curb),
+            // A 6 m hole (parked car), then the curb goes on straight.
+            l(&[(46.0, 5.0), (60.0, 5.0)], Side::Left, Category::Curb),
+            l(&[(60.0, 5.0), (66.0, 5.0)], Side::Left, Category::CurbCut),
+            // An intersection corner turning away: its 10 m hole to the next curb is not
+            // straight, so it is no occlusion.
+            l(
+                &[(66.0, 5.0), (70.0, 9.0)],
+                Side::Left,
+                Category::Intersection,
+            ),
+            l(
+                &[(80.0, 9.0), (84.0, 5.0), (120.0, 5.0)],
+                Side::Left,
+                Category::Curb,
+            ),
+            l(&[(0.0, -5.0), (20.0, -5.0)], Side::Right, Category::Curb),
+            l(&[(20.0, -5.0), (40.0, -7.0)], Side::Right, Category::BusBay),
+        ];
+        let w = windows_of_interest(&refs, 8.0);
+        let names: Vec<&str> = w.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["curb_cut", "intersection", "bus_bay", "occlusion"]);
+        assert_eq!(w[0].1.center, [63.0, 5.0]);
+        assert_eq!(w[3].1.center, [43.0, 5.0]);
+        assert!((w[2].1.center[0] - 30.0).abs() < 1e-9);
+        assert_eq!(w[3].1.half_size_m, 8.0);
+        assert!(windows_of_interest(&refs[..1], 8.0).is_empty());
     }
 
     #[test]
