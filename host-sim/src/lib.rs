@@ -24,3 +24,4 @@ pub mod eval;
 pub mod io;
 pub mod model;
 pub mod plot;
+pub mod simulate;
