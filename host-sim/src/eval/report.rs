@@ -445,4 +445,71 @@ mod tests {
             .to_string();
         assert!(err.contains("a-file"), "{err}");
     }
+
+    /// Draws the demo's pictures for a simulated scene, with the reference itself, shifted
+    /// 20 mm and with every fifth metre left out, standing in for the extraction. For looking
+    /// at the pictures: `CURBTRACE_PLOT_DIR=/tmp/x CURBTRACE_SCENE=kawasaki cargo test -p
+    /// curbtrace-host-sim --release pictures_of_a_simulated_scene -- --ignored`.
+    #[test]
+    #[ignore = "slow; for looking at the pictures of a simulated scene"]
+    fn pictures_of_a_simulated_scene() {
+        use crate::simulate::{scene_by_name, simulate};
+        let name = std::env::var("CURBTRACE_SCENE").unwrap_or_else(|_| "tiny".into());
+        let spec = scene_by_name(&name).unwrap();
+        let t = Instant::now();
+        let sim = simulate(&spec, 1, None, false).unwrap();
+        let sim_s = t.elapsed().as_secs_f64();
+        let o = sim.world.spec.origin;
+        let x: Vec<f64> = sim.returns.iter().map(|r| r.p[0] + o[0]).collect();
+        let y: Vec<f64> = sim.returns.iter().map(|r| r.p[1] + o[1]).collect();
+        let z: Vec<f64> = sim.returns.iter().map(|r| r.p[2] + o[2]).collect();
+        let traj: Vec<[f64; 2]> = sim
+            .traj
+            .samples
+            .iter()
+            .map(|p| [p.x + o[0], p.y + o[1]])
+            .collect();
+        let ext: Vec<EdgeLine> = sim
+            .reference
+            .iter()
+            .flat_map(|l| {
+                let pts: Vec<[f64; 3]> =
+                    l.points.iter().map(|p| [p[0] + 0.02, p[1], p[2]]).collect();
+                pts.chunks(5)
+                    .enumerate()
+                    .filter(|(i, _)| i % 5 != 4)
+                    .map(|(_, c)| EdgeLine {
+                        points: c.to_vec(),
+                        ..l.clone()
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = std::env::var_os("CURBTRACE_PLOT_DIR")
+            .map(|d| PathBuf::from(d).join(&name))
+            .unwrap_or_else(|| tmp.path().to_path_buf());
+        let inp = DemoInputs {
+            scene: name.clone(),
+            method: "reference-shifted".into(),
+            command: "cargo test pictures_of_a_simulated_scene".into(),
+            cloud: Cloud {
+                x: &x,
+                y: &y,
+                z: &z,
+            },
+            trajectory_xy: &traj,
+            reference: &sim.reference,
+            extracted: &ext,
+            cross_section: None,
+            extra_windows: vec![],
+            facts: vec![("points".into(), x.len().to_string())],
+            parameters: vec![],
+            timings: vec![("simulate".into(), sim_s)],
+            files: vec![],
+        };
+        let out = write_demo_outputs(&dir, &inp).unwrap();
+        eprintln!("{}", out.eval.to_markdown());
+        eprintln!("{:?}", out.pictures);
+    }
 }
