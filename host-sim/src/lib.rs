@@ -24,4 +24,5 @@ pub mod eval;
 pub mod io;
 pub mod model;
 pub mod plot;
+pub mod replay;
 pub mod simulate;
