@@ -38,5 +38,23 @@ for feat in libm micromath; do
     -Zbuild-std=core --no-default-features --features "$feat"
 done
 
+# --- firmware: the core on the STM32F405 under QEMU (firmware/check.sh) ----------------------
+step "firmware: cargo fmt --check, clippy on the host target (-D warnings), host-check tests"
+(cd firmware && cargo fmt --check)
+(cd firmware && cargo clippy --release --target x86_64-unknown-linux-gnu \
+  --config 'profile.release.panic="abort"' -- -D warnings)
+HC_TARGET="${CARGO_TARGET_DIR:-$ROOT/target}/firmware-host-check"
+cargo fmt --check --manifest-path firmware/host-check/Cargo.toml
+cargo clippy --manifest-path firmware/host-check/Cargo.toml --target-dir "$HC_TARGET" --all-targets -- -D warnings
+cargo test --manifest-path firmware/host-check/Cargo.toml --target-dir "$HC_TARGET"
+
+step "firmware: a tiny simulated stream through QEMU and the host core, compared (firmware/check.sh)"
+FW_WORK=$(mktemp -d)
+cargo run --release --quiet -p curbtrace-host-sim -- simulate --scene tiny -o "$FW_WORK/sim"
+cargo run --release --quiet -p curbtrace-host-sim -- replay "$FW_WORK/sim/points.laz" \
+  --trajectory "$FW_WORK/sim/trajectory.csv" -o "$FW_WORK/tiny.bin"
+QEMU_TIMEOUT=300 firmware/check.sh "$FW_WORK/tiny.bin"
+rm -rf "$FW_WORK"
+
 echo
 echo "all checks passed"

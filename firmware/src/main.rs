@@ -109,18 +109,15 @@ fn main() -> ! {
     drop(output);
     drop(input);
     debug::exit(EXIT_SUCCESS);
-    loop {
-        cortex_m::asm::udf();
-    }
+    // Unreachable under QEMU; on a board without a debugger, stop here.
+    cortex_m::asm::udf()
 }
 
 /// Leaves QEMU with a failing exit status (and never returns).
 fn exit_failure() -> ! {
     debug::exit(EXIT_FAILURE);
     // Unreachable under QEMU; on a board without a debugger, stop here.
-    loop {
-        cortex_m::asm::udf();
-    }
+    cortex_m::asm::udf()
 }
 
 #[exception]

@@ -6,7 +6,8 @@
 # tables (binutils addr2line -i), so no function needs #[inline(never)] for its cost to be
 # measured. STAGES has lines "NAME EXTENDED-REGEX"; for each address the frames are tried
 # from the innermost inlined function outwards, and the first frame matching any stage's
-# regex (tried in file order) names the stage. Addresses no stage claims are "other" when
+# regex (tried in file order) names the stage; a frame whose first match is named "skip"
+# is passed over (code shared by two stages, such as the CRC, belongs to its caller). Addresses no stage claims are "other" when
 # some frame is the firmware's own code (the loop, semihosting I/O, start-up) and
 # "inherit" otherwise (out-of-line helpers such as libm, memcpy, core::fmt: charged to the
 # stage that called them).
@@ -30,7 +31,10 @@ awk -v s=$((16#$start)) -v n=$((16#$size)) 'BEGIN { for (a = s; a < s + n; a += 
     function classify(   i, k) {
       for (i = 0; i < nf; i++)
         for (k = 0; k < ns; k++)
-          if (frame[i] ~ re[k]) return name[k]
+          if (frame[i] ~ re[k]) {
+            if (name[k] != "skip") return name[k]
+            break
+          }
       for (i = 0; i < nf; i++) if (frame[i] ~ own) return "other"
       return "inherit"
     }
