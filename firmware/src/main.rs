@@ -15,7 +15,7 @@
 mod semihosting_io;
 mod stack;
 
-use core::ffi::CStr;
+use curbtrace_firmware::args::{self, Command};
 
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
@@ -47,42 +47,39 @@ const CHUNK: usize = 512;
 
 #[entry]
 fn main() -> ! {
-    let mut cmdline = [0u8; 256];
-    let mut names: [&[u8]; 2] = [b"stream.bin", b"results.bin"];
-    let mut name_bufs = [[0u8; 120]; 2];
-    if let Ok(line) = semihosting_io::command_line(&mut cmdline) {
-        for (i, word) in line
-            .split(|&b| b == b' ')
-            .filter(|w| !w.is_empty())
-            .skip(1)
-            .take(2)
-            .enumerate()
-        {
-            names[i] = word;
+    let mut cmdline = [0u8; 512];
+    let len = match semihosting_io::command_line(&mut cmdline[..511]) {
+        Ok(line) => line.len(),
+        Err(_) => 0,
+    };
+    let (input_name, output_name) = match args::parse(&mut cmdline, len) {
+        Ok(Command::Process { input, output }) => (input, output),
+        Ok(Command::SelfTestOverflow) => {
+            let mut seed = [0u8; 64];
+            figure!("never_printed", selftest::overflow(&mut seed, u32::MAX));
+            exit_failure()
         }
-    }
-    let mut cnames: [&CStr; 2] = [c"", c""];
-    for i in 0..2 {
-        let n = names[i].len().min(name_bufs[i].len() - 1);
-        name_bufs[i][..n].copy_from_slice(&names[i][..n]);
-    }
-    for i in 0..2 {
-        cnames[i] = match CStr::from_bytes_until_nul(&name_bufs[i]) {
-            Ok(c) => c,
-            Err(_) => exit_failure(),
-        };
-    }
-    let mut input = match HostFile::open(cnames[0], Mode::ReadBinary) {
-        Ok(f) => f,
+        Ok(Command::SelfTestHardFault) => {
+            figure!("never_printed", selftest::hardfault());
+            exit_failure()
+        }
+        Ok(Command::SelfTestPanic) => selftest::panic(),
         Err(e) => {
-            fail!("cannot open input {:?}: {}", cnames[0], e);
+            fail!("bad command line: {:?}", e);
             exit_failure()
         }
     };
-    let mut output = match HostFile::open(cnames[1], Mode::WriteBinary) {
+    let mut input = match HostFile::open(input_name, Mode::ReadBinary) {
         Ok(f) => f,
         Err(e) => {
-            fail!("cannot open output {:?}: {}", cnames[1], e);
+            fail!("cannot open input {:?}: {}", input_name, e);
+            exit_failure()
+        }
+    };
+    let mut output = match HostFile::open(output_name, Mode::WriteBinary) {
+        Ok(f) => f,
+        Err(e) => {
+            fail!("cannot open output {:?}: {}", output_name, e);
             exit_failure()
         }
     };
@@ -111,6 +108,32 @@ fn main() -> ! {
     debug::exit(EXIT_SUCCESS);
     // Unreachable under QEMU; on a board without a debugger, stop here.
     cortex_m::asm::udf()
+}
+
+/// Failures provoked on request (`--selftest=…`), so scripts can check each one ends the
+/// run with a non-zero exit status.
+mod selftest {
+    /// Recurses with 64-byte frames until the stack runs off the bottom of RAM.
+    #[inline(never)]
+    pub fn overflow(seed: &mut [u8; 64], n: u32) -> u32 {
+        let mut frame = *seed;
+        frame[(n % 64) as usize] = n as u8;
+        if n == 0 {
+            return 0;
+        }
+        // black_box keeps the frame alive across the call, so the recursion is not elided.
+        overflow(&mut frame, n - 1) + u32::from(core::hint::black_box(frame)[3])
+    }
+
+    /// Reads from an address in the STM32F405's reserved gap between SRAM and the peripherals (BusFault → HardFault).
+    pub fn hardfault() -> u32 {
+        // SAFETY: deliberately faulting read; the HardFault handler ends the run.
+        unsafe { core::ptr::read_volatile(0x3000_0000 as *const u32) }
+    }
+
+    pub fn panic() -> ! {
+        panic!("self-test panic");
+    }
 }
 
 /// Leaves QEMU with a failing exit status (and never returns).

@@ -20,7 +20,11 @@ pub struct SemihostingError {
 
 impl core::fmt::Display for SemihostingError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(f, "semihosting operation {} failed (returned {})", self.op, self.ret)
+        write!(
+            f,
+            "semihosting operation {} failed (returned {})",
+            self.op, self.ret
+        )
     }
 }
 
@@ -123,7 +127,8 @@ pub fn command_line(buf: &mut [u8]) -> Result<&mut [u8], SemihostingError> {
     let mut block: [usize; 2] = [buf.as_mut_ptr() as usize, buf.len()];
     // SAFETY: the host writes at most `buf.len()` bytes into `buf` and the new length into
     // `block[1]`; both live across the call.
-    let ret = unsafe { cortex_m_semihosting::syscall1(nr::GET_CMDLINE, block.as_mut_ptr() as usize) };
+    let ret =
+        unsafe { cortex_m_semihosting::syscall1(nr::GET_CMDLINE, block.as_mut_ptr() as usize) };
     if ret != 0 || block[1] > buf.len() {
         return Err(SemihostingError {
             op: nr::GET_CMDLINE as u8,
