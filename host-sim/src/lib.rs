@@ -20,5 +20,8 @@
 //! | `plot` | pictures |
 
 pub mod bend;
+pub mod eval;
 pub mod io;
 pub mod model;
+pub mod plot;
+pub mod simulate;
