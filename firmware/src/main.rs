@@ -23,23 +23,31 @@ use embedded_io::{Read, Write};
 
 use semihosting_io::{HostFile, Mode};
 
+// The defmt global logger: frames go to the host's stdout over semihosting.
+#[cfg(feature = "defmt")]
+use defmt_semihosting as _;
+
 /// Prints one `name: value` figure line (semihosting stdout, or defmt with `defmt`).
 macro_rules! figure {
     ($name:literal, $value:expr) => {{
         #[cfg(not(feature = "defmt"))]
         cortex_m_semihosting::hprintln!(concat!($name, ": {}"), $value);
         #[cfg(feature = "defmt")]
-        defmt::println!(concat!($name, ": {}"), $value);
+        defmt::println!("{=str}: {}", $name, $value);
     }};
 }
 
-/// Prints an error line on the host's stderr (or defmt) before a failing exit.
+/// Prints an error line on the host's stderr before a failing exit (with `defmt`: the
+/// message's format string as a defmt error; the values need semihosting's formatter).
 macro_rules! fail {
-    ($($arg:tt)*) => {{
+    ($fmt:literal $(, $arg:expr)* $(,)?) => {{
         #[cfg(not(feature = "defmt"))]
-        cortex_m_semihosting::heprintln!($($arg)*);
+        cortex_m_semihosting::heprintln!($fmt $(, $arg)*);
         #[cfg(feature = "defmt")]
-        defmt::error!("firmware failed");
+        {
+            $(let _ = &$arg;)*
+            defmt::error!("{=str}", $fmt);
+        }
     }};
 }
 
