@@ -22,3 +22,4 @@
 pub mod bend;
 pub mod io;
 pub mod model;
+pub mod qiu;
