@@ -20,6 +20,9 @@
 //! | `plot` | pictures |
 
 pub mod bend;
+pub mod eval;
 pub mod io;
 pub mod model;
+pub mod plot;
 pub mod qiu;
+pub mod simulate;
