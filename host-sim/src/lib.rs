@@ -25,4 +25,5 @@ pub mod io;
 pub mod model;
 pub mod plot;
 pub mod replay;
+pub mod qiu;
 pub mod simulate;
