@@ -20,7 +20,9 @@
 //! | `plot` | pictures |
 
 pub mod bend;
+pub mod config;
 pub mod io;
 pub mod model;
+pub mod pipeline;
 pub mod replay;
 pub mod simulate;

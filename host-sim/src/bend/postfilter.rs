@@ -94,11 +94,7 @@ fn segments_cross(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
 /// Filter 3: removes tracks one of whose ends sees the trajectory only across another
 /// track of the same side. All tests are made against the tracks as they came in, so
 /// the result does not depend on the order.
-pub fn remove_outside_roadway(
-    input: &BendInput,
-    route: &Route,
-    tracks: Vec<Track>,
-) -> Vec<Track> {
+pub fn remove_outside_roadway(input: &BendInput, route: &Route, tracks: Vec<Track>) -> Vec<Track> {
     let polys: Vec<Vec<[f64; 2]>> = tracks
         .iter()
         .map(|t| {
@@ -124,7 +120,9 @@ pub fn remove_outside_roadway(
                 (0..tracks.len()).any(|o| {
                     o != k
                         && tracks[o].side == tracks[k].side
-                        && polys[o].windows(2).any(|w| segments_cross(e, q, w[0], w[1]))
+                        && polys[o]
+                            .windows(2)
+                            .any(|w| segments_cross(e, q, w[0], w[1]))
                 })
             })
         })
@@ -269,7 +267,11 @@ pub fn to_edge_lines(
 /// Runs `(first, last, category)` of equal category over the vertices (consecutive runs
 /// share their boundary vertex); runs shorter than `min_run_m` are absorbed by the
 /// neighbour before them (or after, for the first run).
-fn category_runs(xy: &[[f64; 2]], cats: &[Category], min_run_m: f64) -> Vec<(usize, usize, Category)> {
+fn category_runs(
+    xy: &[[f64; 2]],
+    cats: &[Category],
+    min_run_m: f64,
+) -> Vec<(usize, usize, Category)> {
     if xy.is_empty() {
         return Vec::new();
     }
@@ -334,10 +336,25 @@ mod tests {
 
     #[test]
     fn crossing_segments() {
-        assert!(segments_cross([0.0, 0.0], [2.0, 2.0], [0.0, 2.0], [2.0, 0.0]));
-        assert!(!segments_cross([0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]));
+        assert!(segments_cross(
+            [0.0, 0.0],
+            [2.0, 2.0],
+            [0.0, 2.0],
+            [2.0, 0.0]
+        ));
+        assert!(!segments_cross(
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [0.0, 1.0],
+            [1.0, 1.0]
+        ));
         // Touching at an end point is not a crossing.
-        assert!(!segments_cross([0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [1.0, 1.0]));
+        assert!(!segments_cross(
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [1.0, 0.0],
+            [1.0, 1.0]
+        ));
     }
 
     #[test]

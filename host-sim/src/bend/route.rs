@@ -65,7 +65,11 @@ impl Route {
         }
         let k = self.t.partition_point(|&u| u <= t).clamp(1, n - 1);
         let (a, b) = (self.t[k - 1], self.t[k]);
-        let w = if b > a { ((t - a) / (b - a)).clamp(0.0, 1.0) } else { 0.0 };
+        let w = if b > a {
+            ((t - a) / (b - a)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         Some((k - 1, w))
     }
 
@@ -112,8 +116,14 @@ impl Route {
         let (_, k0) = best?;
         // Refine on the original segments around it (±DECIMATE_M worth of samples).
         let s0 = self.s[k0];
-        let lo = self.s.partition_point(|&s| s < s0 - 2.0 * DECIMATE_M).saturating_sub(1);
-        let hi = self.s.partition_point(|&s| s <= s0 + 2.0 * DECIMATE_M).min(self.s.len() - 1);
+        let lo = self
+            .s
+            .partition_point(|&s| s < s0 - 2.0 * DECIMATE_M)
+            .saturating_sub(1);
+        let hi = self
+            .s
+            .partition_point(|&s| s <= s0 + 2.0 * DECIMATE_M)
+            .min(self.s.len() - 1);
         let mut best_p = ([self.x[k0], self.y[k0]], f64::INFINITY, k0);
         for k in lo..=hi {
             let seg_end = (k + 1).min(hi);

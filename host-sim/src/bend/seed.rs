@@ -215,7 +215,11 @@ mod tests {
         let mut y = Vec::new();
         for k in 0..30 {
             let xx = k as f64 * 0.1;
-            let off = if k % 3 == 1 { 0.3 + 0.03 * k as f64 } else { 0.0 };
+            let off = if k % 3 == 1 {
+                0.3 + 0.03 * k as f64
+            } else {
+                0.0
+            };
             x.push(600_000.0 + xx);
             y.push(4_000_000.0 + 0.5 * xx + 3.0 + off);
         }

@@ -129,7 +129,11 @@ fn make_scene(cfg: &SceneCfg) -> Scene {
             let spacing = 0.01 + 0.004 * u.abs();
             let s = s_line + u * tan_yaw;
             let side_k = if u >= 0.0 { 0 } else { 1 };
-            let toe = if u >= 0.0 { (cfg.left)(s) } else { (cfg.right)(s) };
+            let toe = if u >= 0.0 {
+                (cfg.left)(s)
+            } else {
+                (cfg.right)(s)
+            };
             let (p, h) = pose_at(cfg, s);
             let l = left_of(h);
             let mut z = Z0;
@@ -220,7 +224,9 @@ fn make_scene(cfg: &SceneCfg) -> Scene {
         let mut s = -10.0;
         while s <= cfg.length_m + 10.0 {
             let hidden = side == Side::Left
-                && cfg.car.is_some_and(|(c0, c1, _)| s >= c0 - 0.05 && s <= c1 + 0.05);
+                && cfg
+                    .car
+                    .is_some_and(|(c0, c1, _)| s >= c0 - 0.05 && s <= c1 + 0.05);
             let seen = |ut: f64| (0.0..=s_last).contains(&(s - ut * tan_yaw));
             match f(s) {
                 Some((ut, _, _)) if !hidden && seen(ut) => {
@@ -275,7 +281,11 @@ fn rms_mm_inner(sc: &Scene, edges: &[EdgeLine]) -> f64 {
 }
 
 fn side_length(edges: &[EdgeLine], side: Side) -> f64 {
-    edges.iter().filter(|e| e.side == side).map(|e| e.length_m()).sum()
+    edges
+        .iter()
+        .filter(|e| e.side == side)
+        .map(|e| e.length_m())
+        .sum()
 }
 
 fn straight_left(_: f64) -> Option<(f64, f64, f64)> {
@@ -361,11 +371,18 @@ fn a_60_m_bend_is_followed() {
     let sc = make_scene(&cfg);
     let edges = extract_edges(&sc.input(), &BendParams::default());
     for side in [Side::Left, Side::Right] {
-        assert_eq!(edges.iter().filter(|e| e.side == side).count(), 1, "{side:?}");
+        assert_eq!(
+            edges.iter().filter(|e| e.side == side).count(),
+            1,
+            "{side:?}"
+        );
         // The toe arcs are (60 ∓ offset)/60 of the 39.93 m driven.
         let want = 39.93 * if side == Side::Left { 56.0 } else { 63.5 } / 60.0;
         let got = side_length(&edges, side);
-        assert!(got > 0.95 * want && got < 1.01 * want, "{side:?}: {got} of {want}");
+        assert!(
+            got > 0.95 * want && got < 1.01 * want,
+            "{side:?}: {got} of {want}"
+        );
     }
     let rms = rms_mm(&sc, &edges);
     assert!(rms < 20.0, "RMS {rms} mm");
@@ -408,7 +425,10 @@ fn a_curb_cut_is_tracked_through_and_labelled() {
     assert!((h - 0.025).abs() < 0.01, "{h}");
     // The cut piece spans about s = 12 … 16 (x = X0 + s).
     let (x0, x1) = (cut.points[0][0] - X0, cut.points.last().unwrap()[0] - X0);
-    assert!((x0 - 12.0).abs() < 0.7 && (x1 - 16.0).abs() < 0.7, "{x0} {x1}");
+    assert!(
+        (x0 - 12.0).abs() < 0.7 && (x1 - 16.0).abs() < 0.7,
+        "{x0} {x1}"
+    );
     assert!(side_length(&edges, Side::Left) > 29.0);
     assert!(rms_mm(&sc, &edges) < 20.0);
 }

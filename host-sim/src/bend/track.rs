@@ -51,7 +51,10 @@ impl Claims {
     }
 
     fn cell(&self, x: f64, y: f64) -> (i64, i64) {
-        ((x / self.join_m).floor() as i64, (y / self.join_m).floor() as i64)
+        (
+            (x / self.join_m).floor() as i64,
+            (y / self.join_m).floor() as i64,
+        )
     }
 
     /// Registers a track's polyline (a single point is a segment of length zero).
@@ -67,8 +70,14 @@ impl Claims {
         for (a, b) in segs {
             let (ia, ib) = (a as usize, b as usize);
             let r = self.join_m;
-            let (x0, y0) = (input.x[ia].min(input.x[ib]) - r, input.y[ia].min(input.y[ib]) - r);
-            let (x1, y1) = (input.x[ia].max(input.x[ib]) + r, input.y[ia].max(input.y[ib]) + r);
+            let (x0, y0) = (
+                input.x[ia].min(input.x[ib]) - r,
+                input.y[ia].min(input.y[ib]) - r,
+            );
+            let (x1, y1) = (
+                input.x[ia].max(input.x[ib]) + r,
+                input.y[ia].max(input.y[ib]) + r,
+            );
             let (c0, c1) = (self.cell(x0, y0), self.cell(x1, y1));
             // A segment longer than a few hundred cells is a broken input; skip the rest.
             let cells = (c1.0 - c0.0 + 1).saturating_mul(c1.1 - c0.1 + 1);
@@ -258,7 +267,11 @@ fn track_one_way(
 
     for _ in 0..params.max_steps {
         // The search position (Fig. 7): one search distance ahead along v.
-        let pred = [cur[0] + d_s * v[0], cur[1] + d_s * v[1], cur[2] + d_s * v[2]];
+        let pred = [
+            cur[0] + d_s * v[0],
+            cur[1] + d_s * v[1],
+            cur[2] + d_s * v[2],
+        ];
         let vh = [v[0], v[1]];
         let vh_len = vh[0].hypot(vh[1]).max(1e-12);
         set.clear();
@@ -276,8 +289,8 @@ fn track_one_way(
                     return;
                 }
                 // Only points ahead of the current position: the track must progress.
-                let ahead = ((input.x[i] - cur[0]) * vh[0] + (input.y[i] - cur[1]) * vh[1])
-                    / vh_len;
+                let ahead =
+                    ((input.x[i] - cur[0]) * vh[0] + (input.y[i] - cur[1]) * vh[1]) / vh_len;
                 if ahead > 0.25 * d_s {
                     set.push(i);
                 }
@@ -308,7 +321,11 @@ fn track_one_way(
         let v_elev = v[2].atan2(vh_len);
         let mut best: Option<(f64, usize)> = None;
         for &i in &set {
-            let d = [input.x[i] - cur[0], input.y[i] - cur[1], input.z[i] - cur[2]];
+            let d = [
+                input.x[i] - cur[0],
+                input.y[i] - cur[1],
+                input.z[i] - cur[2],
+            ];
             let dh = d[0].hypot(d[1]);
             let e_b = -(input.rho_deg[i] as f64 - mu) / sigma;
             // Horizontal angle between v and d (Eq. 6), in [0, π].
