@@ -27,5 +27,8 @@ pub mod model;
 pub mod pipeline;
 pub mod plot;
 pub mod qiu;
+pub mod io;
+pub mod model;
+pub mod pipeline;
 pub mod replay;
 pub mod simulate;
