@@ -27,8 +27,5 @@ pub mod model;
 pub mod pipeline;
 pub mod plot;
 pub mod qiu;
-pub mod io;
-pub mod model;
-pub mod pipeline;
 pub mod replay;
 pub mod simulate;
