@@ -71,6 +71,38 @@ pub enum Crs {
     Wkt(String),
 }
 
+impl Crs {
+    /// The EPSG code: the code itself, or the root `AUTHORITY["EPSG","N"]` of a WKT (the
+    /// last AUTHORITY in WKT1 belongs to the outermost object).
+    pub fn epsg_code(&self) -> Option<u32> {
+        match self {
+            Crs::Epsg(c) => Some(*c),
+            Crs::Wkt(w) => {
+                let i = w.rfind("AUTHORITY[")?;
+                let rest = &w[i + "AUTHORITY[".len()..];
+                let mut parts = rest.split(',');
+                let auth = parts.next()?.trim().trim_matches('"');
+                let code = parts.next()?.trim().trim_end_matches(']').trim_matches('"');
+                if !auth.eq_ignore_ascii_case("EPSG") {
+                    return None;
+                }
+                // The root AUTHORITY closes the whole WKT: only `]` may follow it.
+                let after = rest.find(']').map(|k| &rest[k + 1..])?;
+                if !after.chars().all(|c| c == ']' || c.is_whitespace()) {
+                    return None;
+                }
+                code.parse().ok()
+            }
+        }
+    }
+
+    /// True when both name the same CRS: equal, or the same EPSG code.
+    pub fn same_as(&self, other: &Crs) -> bool {
+        self == other
+            || matches!((self.epsg_code(), other.epsg_code()), (Some(a), Some(b)) if a == b)
+    }
+}
+
 /// A road-edge line (extracted or reference) in world coordinates, with its properties.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EdgeLine {
@@ -320,6 +352,17 @@ mod tests {
         assert_eq!(crs, Some(Crs::Epsg(6677)));
         assert_eq!(back, lines);
         assert!((back[0].length_m() - 5.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn wkt_with_root_epsg_authority_is_the_same_crs_as_the_code() {
+        let wkt = Crs::Wkt(r#"PROJCS["JGD2011 / UTM zone 54N",GEOGCS["JGD2011",AUTHORITY["EPSG","6668"]],UNIT["metre",1,AUTHORITY["EPSG","9001"]],AUTHORITY["EPSG","6691"]]"#.into());
+        assert_eq!(wkt.epsg_code(), Some(6691));
+        assert!(wkt.same_as(&Crs::Epsg(6691)));
+        assert!(!wkt.same_as(&Crs::Epsg(6668)));
+        let nested_only =
+            Crs::Wkt(r#"PROJCS["x",GEOGCS["y",AUTHORITY["EPSG","6668"]],UNIT["metre",1]]"#.into());
+        assert_eq!(nested_only.epsg_code(), None);
     }
 
     #[test]

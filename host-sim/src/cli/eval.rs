@@ -36,7 +36,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let (reference, ref_crs) = read(&args.reference)?;
     let (extracted, ext_crs) = read(&args.extracted)?;
     if let (Some(a), Some(b)) = (&ref_crs, &ext_crs) {
-        if a != b {
+        if !a.same_as(b) {
             anyhow::bail!(
                 "{} and {} carry different CRS ({a:?} vs {b:?}); reproject one first",
                 args.reference.display(),
