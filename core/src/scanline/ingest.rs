@@ -756,4 +756,64 @@ mod tests {
         assert_eq!(ing.counters().split_config, 1);
         let _ = MAX_POINTS_PER_PACKET;
     }
+
+    proptest::proptest! {
+        /// Random lines, random packet sizes, random garbage between packets, random write
+        /// sizes: every line comes out whole (or truncated at N), the garbage is counted
+        /// byte for byte and every byte and point is accounted for.
+        #[test]
+        fn random_streams_with_garbage(
+            line_lens in proptest::collection::vec(1u32..300, 1..6),
+            packet_sizes in proptest::collection::vec(1usize..=64, 1..8),
+            garbage in proptest::collection::vec(proptest::collection::vec(proptest::prelude::any::<u8>(), 0..40), 1..8),
+            writes in proptest::collection::vec(1usize..700, 1..8),
+        ) {
+            let mut enc = StreamEncoder::new();
+            let mut buf = [0u8; MAX_PACKET_LEN];
+            let mut s = Vec::new();
+            let mut garbage_total = 0usize;
+            let mut pts = Vec::new();
+            for &len in &line_lens {
+                for k in 0..len {
+                    pts.push(PointRecord { tag: pts.len() as u32, ..pt(k, k == 0) });
+                }
+            }
+            let mut at = 0;
+            let mut k = 0;
+            while at < pts.len() {
+                let g = &garbage[k % garbage.len()];
+                // Garbage must not end in a sync byte run that merges with the packet's.
+                s.extend_from_slice(g);
+                garbage_total += g.len();
+                let n = packet_sizes[k % packet_sizes.len()].min(pts.len() - at);
+                let m = enc.encode_points(0, &pts[at..at + n], &mut buf).unwrap();
+                s.extend_from_slice(&buf[..m]);
+                at += n;
+                k += 1;
+            }
+            let mut ing = Ingest::<2048, 128>::new();
+            let mut lines = Vec::new();
+            let mut fed = 0;
+            let mut w = 0;
+            while fed < s.len() {
+                let end = (fed + writes[w % writes.len()]).min(s.len());
+                w += 1;
+                fed += ing.write(&s[fed..end]);
+                lines.extend(drain(&mut ing).1);
+            }
+            ing.finish();
+            lines.extend(drain(&mut ing).1);
+            let mut expected = Vec::new();
+            let mut first = 0;
+            for (i, &len) in line_lens.iter().enumerate() {
+                expected.push((i as u32, first, (len as usize).min(128), len.saturating_sub(128)));
+                first += len;
+            }
+            proptest::prop_assert_eq!(lines, expected);
+            let c = ing.counters();
+            proptest::prop_assert_eq!(c.bytes_garbage, garbage_total as u64);
+            proptest::prop_assert_eq!(c.seq_gaps, 0);
+            check_balance(&ing);
+        }
+    }
 }
