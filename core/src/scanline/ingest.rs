@@ -757,6 +757,26 @@ mod tests {
         let _ = MAX_POINTS_PER_PACKET;
     }
 
+    /// The memory of ingest state for the firmware budget (128 KiB in all): the ring, the
+    /// line (12 B/point) and under 640 B of parser/assembler state and counters.
+    #[test]
+    fn memory_footprint() {
+        use core::mem::size_of;
+        const R: usize = 40 * 1024; // one 2000-point line of packets (40 768 B) in flight
+        for (n, size, line) in [
+            (2048, size_of::<Ingest<R, 2048>>(), size_of::<Line<2048>>()),
+            (4096, size_of::<Ingest<R, 4096>>(), size_of::<Line<4096>>()),
+        ] {
+            std::println!(
+                "Ingest<{R}, {n}> = {size} B (ring {R}, Line {line}, rest {})",
+                size - R - line
+            );
+            assert_eq!(line, 12 * n + 24);
+            assert!(size - R - line < 640, "{size}");
+        }
+        assert_eq!(size_of::<crate::scanline::ring::Ring<R>>(), R + 24);
+    }
+
     proptest::proptest! {
         /// Random lines, random packet sizes, random garbage between packets, random write
         /// sizes: every line comes out whole (or truncated at N), the garbage is counted
@@ -814,6 +834,38 @@ mod tests {
             proptest::prop_assert_eq!(c.bytes_garbage, garbage_total as u64);
             proptest::prop_assert_eq!(c.seq_gaps, 0);
             check_balance(&ing);
+        }
+
+        /// Any bytes: no panic, and every byte and point accounted for (a valid stream
+        /// with random bytes overwritten, so packets, false syncs and CRC failures mix).
+        #[test]
+        fn mutated_streams_never_panic(
+            edits in proptest::collection::vec((0usize..20_000, proptest::prelude::any::<u8>()), 0..40),
+            cut in 0usize..20_000,
+            writes in 1usize..3000,
+        ) {
+            let mut s = stream(3, 200, 37);
+            for (at, v) in edits {
+                let n = s.len();
+                s[at % n] = v;
+            }
+            s.truncate(cut.max(1).min(s.len()));
+            let mut ing = Ingest::<2048, 128>::new();
+            for chunk in s.chunks(writes) {
+                let mut fed = 0;
+                while fed < chunk.len() {
+                    fed += ing.write(&chunk[fed..]);
+                    while let Some(ev) = ing.poll() {
+                        let _ = ev;
+                    }
+                }
+            }
+            ing.finish();
+            while ing.poll().is_some() {}
+            check_balance(&ing);
+            let c = ing.counters();
+            proptest::prop_assert_eq!(c.bytes_buffered, 0);
+            proptest::prop_assert_eq!(c.points_pending, 0);
         }
     }
 }
