@@ -641,7 +641,20 @@ fn stage_timings() {
     let r = min_med(n, 2000, || {
         bend::windows(core::hint::black_box(&x), &z, d2, &mut s_off, &mut t_off);
     });
-    std::println!("windows: {r:.1?} ns/pt");
+    std::println!("windows (raw line): {r:.1?} ns/pt");
+    let (mut xs1, mut zs1) = (x.clone(), z.clone());
+    let mut scratch = std::vec![0f32; n];
+    smooth::taubin_smooth(&mut xs1, &mut zs1, &mut scratch, 0.3, 20, 0.6307, -0.6732);
+    let r = min_med(n, 2000, || {
+        bend::windows(
+            core::hint::black_box(&xs1),
+            &zs1,
+            d2,
+            &mut s_off,
+            &mut t_off,
+        );
+    });
+    std::println!("windows (smoothed line): {r:.1?} ns/pt");
     let mut rho = std::vec![0f32; n];
     let r = min_med(n, 2000, || {
         bend::bend_angles::<crate::math::Selected>(
