@@ -3,6 +3,37 @@
 //! [`Line`] is the hand-over point between assembly and the kernel: the assembler fills it
 //! (structure of arrays, so the kernel can work in place and vectorise), the kernel
 //! processes it in place.
+//!
+//! ```
+//! use curbtrace_core::scanline::{Ingest, IngestEvent};
+//! use curbtrace_core::wire::{PointRecord, StreamEncoder, MAX_PACKET_LEN};
+//!
+//! let mut enc = StreamEncoder::new();
+//! let mut buf = [0u8; MAX_PACKET_LEN];
+//! let pts: Vec<PointRecord> = (0..6)
+//!     .map(|i| PointRecord {
+//!         dt_ns: i * 1000,
+//!         x_m: 1.0 - 0.1 * i as f32,
+//!         z_m: -2.0,
+//!         intensity: 0,
+//!         line_start: i % 3 == 0, // two lines of three points
+//!         tag: i,
+//!     })
+//!     .collect();
+//! let n = enc.encode_points(1_000_000_000, &pts, &mut buf).unwrap();
+//!
+//! let mut ingest = Ingest::<2048, 256>::new();
+//! assert_eq!(ingest.write(&buf[..n]), n); // a producer: DMA, UART, file reader
+//! ingest.finish(); // end of stream: the last line becomes pollable
+//! let mut lines = Vec::new();
+//! while let Some(ev) = ingest.poll() {
+//!     if let IngestEvent::Line(line) = ev {
+//!         lines.push((line.index, line.start_time_ns, line.tag[..line.len()].to_vec()));
+//!     }
+//! }
+//! assert_eq!(lines, [(0, 1_000_000_000, vec![0, 1, 2]), (1, 1_000_003_000, vec![3, 4, 5])]);
+//! assert_eq!(ingest.counters().points_in_lines, 6);
+//! ```
 
 pub mod assemble;
 mod ingest;

@@ -3,8 +3,9 @@
 //! 0xFFFFFFFF. Check value of `b"123456789"`: 0xCBF43926.
 //!
 //! Why this CRC and not CRC-32C: the STM32F405's CRC peripheral computes exactly this
-//! polynomial (on 32-bit words, unreflected — with `RBIT` on input and output words it
-//! yields this CRC, and every region the format protects is a multiple of 4 bytes long), and
+//! polynomial (on 32-bit words, unreflected, no final XOR — with `RBIT` on each input word
+//! and on the result, then inverting, it yields this CRC; every region the format protects
+//! is a multiple of 4 bytes long), and
 //! every host language has it in its standard library, so a stream can be checked with
 //! one line of Python. Error detection for packets of at most [`super::MAX_PACKET_LEN`]
 //! bytes (< 12 000 bits): every burst of up to 32 bits and every 3-bit error is caught

@@ -16,6 +16,24 @@
 //! keeps the sequence numbers. [`scan`] finds packets in a byte slice (resynchronising
 //! after garbage) for host tools; the ring-buffer path is in [`crate::scanline`].
 //!
+//! ```
+//! use curbtrace_core::wire::{
+//!     scan, Packet, PointRecord, PointsRepr, Scan, StreamEncoder, MAX_PACKET_LEN,
+//! };
+//!
+//! let mut enc = StreamEncoder::new();
+//! let mut buf = [0u8; MAX_PACKET_LEN];
+//! let p = PointRecord { dt_ns: 0, x_m: 1.5, z_m: -2.0, intensity: 300, line_start: true, tag: 7 };
+//! let n = enc.encode_points(1_000_000_000, &[p], &mut buf).unwrap();
+//! assert_eq!(scan(&buf[..n], true), Scan::Packet { len: n });
+//! let packet = Packet::new_checked(&buf[..n]).unwrap();
+//! let repr = PointsRepr::parse(&packet).unwrap();
+//! assert_eq!((repr.base_time_ns, repr.points[0]), (1_000_000_000, p));
+//! // NaN cannot be encoded.
+//! let bad = PointRecord { x_m: f32::NAN, ..p };
+//! assert!(enc.encode_points(0, &[bad], &mut buf).is_err());
+//! ```
+//!
 //! # Panic contract
 //!
 //! Nothing in this module panics on any input. Accessors of [`Packet`] read fields with

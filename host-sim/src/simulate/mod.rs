@@ -1,0 +1,460 @@
+//! The scene simulator behind `curbtrace simulate` (SPEC §4): a physically modelled mobile
+//! laser scanner driving through a street, writing `points.laz`, `trajectory.csv` and
+//! `reference.geojson`.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`scene`] | scene descriptions in road coordinates; the built-in scenes; building the world |
+//! | [`ground`] | road, curbs (batter, rounded top), curb cuts, sidewalks as an exact height field |
+//! | [`prims`] | walls, fences, parked cars, poles, weeds, leaves, and the ray walk through them |
+//! | [`drive`] | the vehicle's path, speed and attitude → the 200 Hz trajectory |
+//! | [`scanner`] | the VQ-250-like profiler: pulse directions and timing, noise, intensity |
+//! | [`reference`] | the visibility rule and the reference lines |
+//! | [`write`] | LAS 1.4 / LAZ and the trajectory CSV |
+//!
+//! Determinism: every scan line draws its noise from its own generator seeded by
+//! `(seed, line number)`, and lines are gathered in order, so the output is identical for
+//! any number of threads.
+//!
+//! Coordinates: the scene is built in local metres; files carry the scene's CRS coordinates
+//! (JGD2011 / UTM zone 54N, EPSG:6691, hundreds of kilometres from the origin), GPS times are
+//! adjusted standard GPS time near 4e8 s.
+//!
+//! ```no_run
+//! let spec = curbtrace_host_sim::simulate::scene_by_name("tiny").unwrap();
+//! let summary = curbtrace_host_sim::simulate::run(&spec, 1, None, std::path::Path::new("out"), false).unwrap();
+//! println!("{} points", summary.points);
+//! ```
+
+pub mod drive;
+pub mod ground;
+pub mod prims;
+pub mod reference;
+pub mod scanner;
+pub mod scene;
+pub mod write;
+
+pub use scene::{SceneSpec, World, SCENE_NAMES};
+
+/// The brief's name for a scene description.
+pub type Scene = SceneSpec;
+
+use crate::io::trajectory::Trajectory;
+use crate::model::{Category, Crs, EdgeLine};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Errors of the simulator.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// No scene of that name.
+    #[error("unknown scene {name:?}; valid scenes: {}", SCENE_NAMES.join(", "))]
+    UnknownScene {
+        /// The name asked for.
+        name: String,
+    },
+    /// A parameter is out of range.
+    #[error("{0}")]
+    BadParameter(String),
+    /// A file could not be written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The LAS/LAZ or GeoJSON writer failed.
+    #[error("{path}: {what}")]
+    Write {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        what: String,
+    },
+}
+
+/// A built-in scene by name, or an error listing the valid names.
+pub fn scene_by_name(name: &str) -> Result<SceneSpec, SimError> {
+    SceneSpec::by_name(name).ok_or_else(|| SimError::UnknownScene { name: name.into() })
+}
+
+/// A finished simulation in memory (scene-local coordinates for points and trajectory).
+pub struct Simulation {
+    /// The world that was scanned.
+    pub world: World,
+    /// Returns in time order.
+    pub returns: Vec<scanner::Return>,
+    /// The trajectory (scene-local).
+    pub traj: Trajectory,
+    /// Reference lines (CRS coordinates).
+    pub reference: Vec<EdgeLine>,
+    /// Number of scan lines.
+    pub lines: usize,
+    /// Driven length during the scan, metres.
+    pub length_m: f64,
+    /// Scan span, GPS seconds.
+    pub scan: (f64, f64),
+}
+
+/// What a run produced.
+#[derive(Clone, Debug)]
+pub struct SimSummary {
+    /// Scene name.
+    pub scene: String,
+    /// Points written.
+    pub points: usize,
+    /// Scan lines.
+    pub lines: usize,
+    /// Driven length during the scan, metres.
+    pub length_m: f64,
+    /// Scan duration, seconds.
+    pub duration_s: f64,
+    /// Reference length per category, metres, in [`Category::ALL`] order.
+    pub reference_m: [f64; 4],
+    /// Wall-clock seconds for the whole run.
+    pub elapsed_s: f64,
+    /// `points.laz`.
+    pub points_path: PathBuf,
+    /// `trajectory.csv`.
+    pub trajectory_path: PathBuf,
+    /// `reference.geojson`.
+    pub reference_path: PathBuf,
+    /// The CRS written.
+    pub crs: Crs,
+}
+
+fn line_seed(seed: u64, k: u64) -> u64 {
+    // splitmix64 of the pair: independent streams per line, fixed by (seed, k) alone.
+    let mut z = seed ^ k.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x243F_6A88_85A3_08D3;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Simulates a scene in memory. `speed_kmh` overrides the scene's speed.
+pub fn simulate(
+    spec: &SceneSpec,
+    seed: u64,
+    speed_kmh: Option<f64>,
+    progress: bool,
+) -> Result<Simulation, SimError> {
+    let speed = speed_kmh.unwrap_or(spec.speed_kmh);
+    if !(speed.is_finite() && (1.0..=120.0).contains(&speed)) {
+        return Err(SimError::BadParameter(format!(
+            "speed {speed} km/h is out of range (1–120)"
+        )));
+    }
+    let world = World::build(spec.clone(), seed);
+    let drive = drive::plan(&world, speed, seed);
+    let cfg = world.spec.scanner;
+    let dirs = scanner::mount_directions(&cfg);
+    let own: Vec<bool> = dirs
+        .iter()
+        .map(|&d| scanner::hits_own_vehicle(d, cfg.height_m))
+        .collect();
+    let lines = ((drive.scan.1 - drive.scan.0) * cfg.line_rate_hz).round() as usize;
+    let bar = progress.then(|| {
+        let b = indicatif::ProgressBar::new(lines as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} lines, {eta}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b.set_message(format!("simulating {}", spec.name));
+        b
+    });
+    let per_line: Vec<Vec<scanner::Return>> = (0..lines)
+        .into_par_iter()
+        .map(|k| {
+            let mut rng = ChaCha8Rng::seed_from_u64(line_seed(seed, k as u64));
+            let t_line = drive.scan.0 + k as f64 / cfg.line_rate_hz;
+            let r = scanner::cast_line(&world, &drive.traj, &dirs, &own, t_line, &mut rng);
+            if let Some(b) = &bar {
+                b.inc(1);
+            }
+            r
+        })
+        .collect();
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let returns: Vec<scanner::Return> = per_line.into_iter().flatten().collect();
+    let mut vis = reference::Visibility::new(&world.ground);
+    for r in &returns {
+        if let Some(tc) = &r.toe {
+            vis.add(tc);
+        }
+    }
+    let reference = reference::reference_lines(&world.ground, &vis, &drive.traj, world.spec.origin);
+    Ok(Simulation {
+        world,
+        returns,
+        traj: drive.traj,
+        reference,
+        lines,
+        length_m: drive.length_m,
+        scan: drive.scan,
+    })
+}
+
+/// Simulates a scene and writes `points.laz`, `trajectory.csv` and `reference.geojson`
+/// into `out_dir` (created if missing).
+pub fn run(
+    spec: &SceneSpec,
+    seed: u64,
+    speed_kmh: Option<f64>,
+    out_dir: &Path,
+    progress: bool,
+) -> Result<SimSummary, SimError> {
+    let start = Instant::now();
+    std::fs::create_dir_all(out_dir).map_err(|source| SimError::Io {
+        path: out_dir.display().to_string(),
+        source,
+    })?;
+    let sim = simulate(spec, seed, speed_kmh, progress)?;
+    let origin = sim.world.spec.origin;
+    let points_path = out_dir.join("points.laz");
+    let trajectory_path = out_dir.join("trajectory.csv");
+    let reference_path = out_dir.join("reference.geojson");
+    write::write_points(&points_path, &sim.returns, origin, spec.epsg)?;
+    write::write_trajectory(&trajectory_path, &sim.traj, origin)?;
+    let crs = Crs::Epsg(spec.epsg);
+    crate::model::write_geojson(&reference_path, &sim.reference, Some(&crs)).map_err(|e| {
+        SimError::Write {
+            path: reference_path.display().to_string(),
+            what: e.to_string(),
+        }
+    })?;
+    let mut reference_m = [0.0; 4];
+    for l in &sim.reference {
+        if let Some(c) = l.category {
+            let i = Category::ALL.iter().position(|&x| x == c).unwrap_or(0);
+            reference_m[i] += l.length_m();
+        }
+    }
+    Ok(SimSummary {
+        scene: spec.name.clone(),
+        points: sim.returns.len(),
+        lines: sim.lines,
+        length_m: sim.length_m,
+        duration_s: sim.scan.1 - sim.scan.0,
+        reference_m,
+        elapsed_s: start.elapsed().as_secs_f64(),
+        points_path,
+        trajectory_path,
+        reference_path,
+        crs,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Side;
+    use std::sync::OnceLock;
+
+    fn tiny() -> &'static Simulation {
+        static SIM: OnceLock<Simulation> = OnceLock::new();
+        SIM.get_or_init(|| simulate(&scene_by_name("tiny").unwrap(), 7, None, false).unwrap())
+    }
+
+    /// A bare straight road driven due east (heading 90°), no clutter.
+    fn east_spec(drive_m: f64) -> SceneSpec {
+        let mut s = scene_by_name("tiny").unwrap();
+        s.heading_deg = 90.0;
+        s.drive = (0.0, drive_m);
+        s.base.wave_m = 0.0;
+        s.curb_cuts.clear();
+        s.weeds.clear();
+        s.leaves_per_100m = 0.0;
+        s
+    }
+
+    #[test]
+    fn driving_east_gives_heading_90_and_left_is_north() {
+        let world = World::build(east_spec(10.0), 3);
+        let d = drive::plan(&world, 30.0, 3);
+        let s = &d.traj.samples;
+        assert!(s.len() > 200);
+        for w in s.windows(2) {
+            assert!(
+                (w[0].heading_deg - 90.0).abs() < 1e-6,
+                "{}",
+                w[0].heading_deg
+            );
+            assert!(w[1].x > w[0].x && (w[1].t - w[0].t - 0.005).abs() < 1e-6);
+        }
+        // Road half width 4 m, lane 2.3 m from the left curb: the left toe (first toe,
+        // built for Side::Left) lies 2.3 m north of the path.
+        let toe = &world.ground.toes[0];
+        let mid = toe.pts[toe.pts.len() / 2];
+        assert!(
+            (mid[1] - s[0].y - 2.3).abs() < 0.05,
+            "{} {}",
+            mid[1],
+            s[0].y
+        );
+        // The scanner origin is 2 m above the road (cross slope ~2 % → roll ~1°).
+        let road = world.ground.height(s[0].x, s[0].y).unwrap().0;
+        assert!((s[0].z - road - 2.0).abs() < 0.05);
+    }
+
+    #[test]
+    fn left_reference_lines_have_positive_x_prime() {
+        let sim = tiny();
+        let o = sim.world.spec.origin;
+        let (mut left, mut right) = (0.0, 0.0);
+        for line in &sim.reference {
+            for p in &line.points {
+                let (x, y) = (p[0] - o[0], p[1] - o[1]);
+                let q = sim
+                    .traj
+                    .samples
+                    .iter()
+                    .min_by(|a, b| {
+                        let da = (a.x - x).powi(2) + (a.y - y).powi(2);
+                        let db = (b.x - x).powi(2) + (b.y - y).powi(2);
+                        da.total_cmp(&db)
+                    })
+                    .unwrap();
+                let l = q.left();
+                let xp = (x - q.x) * l[0] + (y - q.y) * l[1];
+                match line.side {
+                    Side::Left => assert!(xp > 1.0, "left vertex at x′ = {xp}"),
+                    Side::Right => assert!(xp < -1.0, "right vertex at x′ = {xp}"),
+                }
+            }
+            match line.side {
+                Side::Left => left += line.length_m(),
+                Side::Right => right += line.length_m(),
+            }
+        }
+        // Both curbs seen over about the drive (30 m) plus what the tilted plane sees
+        // before the start and after the end.
+        assert!(left > 28.0 && left < 45.0, "left {left}");
+        assert!(right > 28.0 && right < 45.0, "right {right}");
+    }
+
+    #[test]
+    fn pulses_increase_in_time_on_the_pulse_clock() {
+        let sim = tiny();
+        let dt = 1.0 / 200_000.0;
+        for w in sim.returns.windows(2) {
+            let d = w[1].t - w[0].t;
+            assert!(d > 0.0, "time goes back");
+            let k = (d / dt).round();
+            assert!((d - k * dt).abs() < 1e-7, "off the pulse clock: {d}");
+        }
+        assert!(
+            (sim.returns[0].t - drive::T0_GPS) >= 0.0 && sim.returns[0].t < drive::T0_GPS + 0.01
+        );
+    }
+
+    #[test]
+    fn tiny_counts_are_plausible() {
+        let sim = tiny();
+        let dur = sim.scan.1 - sim.scan.0;
+        assert_eq!(sim.lines, (dur * 100.0).round() as usize);
+        // 30 m at 30 km/h ± 7 %: 3.4–3.9 s.
+        assert!(dur > 3.3 && dur < 3.9, "{dur}");
+        let pulses = sim.lines * 2000;
+        let share = sim.returns.len() as f64 / pulses as f64;
+        // Half the circle looks down at the road, most of the upper half at walls; the
+        // vehicle body and open sky return nothing.
+        assert!(share > 0.5 && share < 0.9, "{share}");
+        let cut: f64 = sim
+            .reference
+            .iter()
+            .filter(|l| l.category == Some(Category::CurbCut))
+            .map(|l| l.length_m())
+            .sum();
+        // 4 m lowered + two 1 m ramps.
+        assert!((cut - 6.0).abs() < 0.6, "{cut}");
+    }
+
+    #[test]
+    fn written_files_round_trip_with_crs_offsets() {
+        let dir = tempfile::tempdir().unwrap();
+        let spec = east_spec(3.0);
+        let s = run(&spec, 5, None, dir.path(), false).unwrap();
+        let sim = simulate(&spec, 5, None, false).unwrap();
+        assert_eq!(s.points, sim.returns.len());
+        let mut r = las::Reader::from_path(&s.points_path).unwrap();
+        let h = r.header().clone();
+        assert_eq!(h.version(), las::Version::new(1, 4));
+        assert_eq!(h.point_format().to_u8().unwrap(), 6);
+        assert_eq!(h.transforms().x.scale, 0.001);
+        assert_eq!(h.transforms().x.offset, spec.origin[0].floor());
+        assert_eq!(h.transforms().y.offset, spec.origin[1].floor());
+        assert_eq!(h.number_of_points() as usize, s.points);
+        let wkt = String::from_utf8_lossy(h.get_wkt_crs_bytes().unwrap()).to_string();
+        assert!(wkt.contains("\"6691\""), "{wkt}");
+        let pd = r.read_points(5000).unwrap();
+        for (p, q) in pd.points().zip(&sim.returns) {
+            let p = p.unwrap();
+            let w = [
+                q.p[0] + spec.origin[0],
+                q.p[1] + spec.origin[1],
+                q.p[2] + spec.origin[2],
+            ];
+            assert!((p.x - w[0]).abs() <= 0.0005 + 1e-9 && (p.y - w[1]).abs() <= 0.0005 + 1e-9);
+            assert!((p.z - w[2]).abs() <= 0.0005 + 1e-9);
+            assert!((p.x - 455000.0).abs() < 1000.0 && (p.y - 3951000.0).abs() < 2000.0);
+            assert_eq!(p.gps_time, Some(q.t));
+            assert!(q.t > 4.0e8 && q.t < 4.0001e8);
+            assert!((p.scan_angle as f64 - q.scan_angle_deg).abs() <= 0.003 + 1e-6);
+            assert_eq!(p.scanner_channel, 0);
+            assert_eq!(p.point_source_id, 1);
+        }
+        let csv = std::fs::read_to_string(&s.trajectory_path).unwrap();
+        let mut rows = csv.lines();
+        assert_eq!(rows.next(), Some("time,x,y,z,roll,pitch,heading"));
+        let first: Vec<f64> = rows
+            .next()
+            .unwrap()
+            .split(',')
+            .map(|v| v.parse().unwrap())
+            .collect();
+        assert!((first[0] - (drive::T0_GPS - drive::TRAJ_MARGIN_S)).abs() < 1e-6);
+        assert!((first[6] - 90.0).abs() < 1e-4);
+        assert!((first[1] - (sim.traj.samples[0].x + spec.origin[0])).abs() < 1e-4);
+        let (refl, crs) = crate::model::read_geojson(&s.reference_path).unwrap();
+        assert_eq!(crs, Some(Crs::Epsg(6691)));
+        assert_eq!(refl.len(), sim.reference.len());
+    }
+
+    #[test]
+    fn output_does_not_depend_on_the_thread_count() {
+        let spec = east_spec(1.0);
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let three = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .unwrap();
+        let a = one.install(|| simulate(&spec, 11, None, false).unwrap());
+        let b = three.install(|| simulate(&spec, 11, None, false).unwrap());
+        assert_eq!(a.returns.len(), b.returns.len());
+        for (x, y) in a.returns.iter().zip(&b.returns) {
+            assert_eq!(x.p, y.p);
+            assert_eq!(x.intensity, y.intensity);
+        }
+        let c = simulate(&spec, 12, None, false).unwrap();
+        assert!(c.returns.iter().zip(&a.returns).any(|(x, y)| x.p != y.p));
+    }
+
+    #[test]
+    fn unknown_scene_lists_the_valid_ones() {
+        let e = scene_by_name("kawasakii").unwrap_err().to_string();
+        assert!(
+            e.contains("kawasakii") && e.contains("kawasaki, sapporo, curvy, tiny"),
+            "{e}"
+        );
+        assert!(simulate(&east_spec(1.0), 1, Some(0.0), false).is_err());
+    }
+}

@@ -1,0 +1,179 @@
+//! Reference lines: the curb toes the scanner saw.
+//!
+//! Honma et al. drew their reference by hand and left out what could not be seen, e.g.
+//! behind vehicles (§3.2). Here the rule is mechanical and uses only the *true* (noise-free)
+//! positions of ground returns:
+//!
+//! **A toe vertex is kept when, within ±[`WINDOW_M`] along the toe, at least one ground
+//! return fell on the road side within [`BAND_M`] of the toe and at least one fell on the
+//! curb side (face, top or the ramp behind a lowered curb) within [`BAND_M`].** Returns on
+//! cars, weeds, leaves or poles do not count. A segment between two kept vertices is kept;
+//! kept segments are joined into lines split where the category or the side changes. So
+//! stretches hidden behind parked cars or never reached (far down a side street) drop out,
+//! and stretches seen before the start or after the end of the drive stay in.
+//!
+//! A segment's category is its vertices' category, or the special one (curb cut,
+//! intersection, bus bay) when they differ. Intersection covers the corner arcs and the
+//! side street's curbs. The side is the sign of the segment midpoint's lateral offset x′
+//! from the nearest trajectory sample (SPEC §2: left positive).
+
+use super::ground::{Ground, ToeCoord};
+use crate::io::trajectory::Trajectory;
+use crate::model::{Category, EdgeLine, Side};
+
+/// Half window along the toe, metres.
+pub const WINDOW_M: f64 = 0.15;
+/// Distance band across the toe, metres.
+pub const BAND_M: f64 = 0.15;
+const BIN_M: f64 = 0.05;
+
+/// Evidence per toe: counts of road-side and curb-side returns in 5 cm bins along it.
+pub struct Visibility {
+    along: Vec<Vec<f64>>,
+    road: Vec<Vec<u32>>,
+    curb: Vec<Vec<u32>>,
+}
+
+impl Visibility {
+    /// Empty evidence for the toes of `ground`.
+    pub fn new(ground: &Ground) -> Self {
+        let along: Vec<Vec<f64>> = ground
+            .toes
+            .iter()
+            .map(|t| {
+                let mut a = vec![0.0; t.pts.len()];
+                for i in 1..t.pts.len() {
+                    let (p, q) = (t.pts[i - 1], t.pts[i]);
+                    a[i] = a[i - 1] + ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2)).sqrt();
+                }
+                a
+            })
+            .collect();
+        let bins =
+            |a: &Vec<f64>| vec![0u32; (a.last().copied().unwrap_or(0.0) / BIN_M) as usize + 2];
+        Visibility {
+            road: along.iter().map(bins).collect(),
+            curb: along.iter().map(bins).collect(),
+            along,
+        }
+    }
+
+    /// Records one ground return at a true position with toe coordinates `tc`.
+    pub fn add(&mut self, tc: &ToeCoord) {
+        let (ti, v) = (tc.toe as usize, tc.vtx as usize);
+        let Some(a) = self.along.get(ti) else { return };
+        if v + 1 >= a.len() {
+            return;
+        }
+        let pos = a[v] + (a[v + 1] - a[v]) * tc.t;
+        let b = ((pos / BIN_M) as usize).min(self.road[ti].len() - 1);
+        if (-BAND_M..-0.003).contains(&tc.s) {
+            self.road[ti][b] += 1;
+        } else if tc.s > 0.003 && tc.s <= BAND_M {
+            self.curb[ti][b] += 1;
+        }
+    }
+
+    /// Whether each vertex of toe `ti` is kept by the rule.
+    pub fn kept(&self, ti: usize) -> Vec<bool> {
+        let prefix = |c: &Vec<u32>| {
+            let mut p = vec![0u32; c.len() + 1];
+            for i in 0..c.len() {
+                p[i + 1] = p[i] + c[i];
+            }
+            p
+        };
+        let (pr, pc) = (prefix(&self.road[ti]), prefix(&self.curb[ti]));
+        let n = self.road[ti].len();
+        self.along[ti]
+            .iter()
+            .map(|&a| {
+                let lo = (((a - WINDOW_M) / BIN_M).floor().max(0.0) as usize).min(n);
+                let hi = ((((a + WINDOW_M) / BIN_M).floor() as usize) + 1).min(n);
+                pr[hi] > pr[lo] && pc[hi] > pc[lo]
+            })
+            .collect()
+    }
+}
+
+/// Builds the reference lines (CRS coordinates: local + `origin`).
+pub fn reference_lines(
+    ground: &Ground,
+    vis: &Visibility,
+    traj: &Trajectory,
+    origin: [f64; 3],
+) -> Vec<EdgeLine> {
+    let poses: Vec<_> = traj.samples.iter().step_by(4).collect();
+    let side_of = |p: [f64; 2]| -> Side {
+        let mut best = (f64::INFINITY, 0usize);
+        for (i, q) in poses.iter().enumerate() {
+            let d2 = (p[0] - q.x).powi(2) + (p[1] - q.y).powi(2);
+            if d2 < best.0 {
+                best = (d2, i);
+            }
+        }
+        let q = poses[best.1];
+        let l = q.left();
+        if (p[0] - q.x) * l[0] + (p[1] - q.y) * l[1] >= 0.0 {
+            Side::Left
+        } else {
+            Side::Right
+        }
+    };
+    let mut out = Vec::new();
+    for (ti, toe) in ground.toes.iter().enumerate() {
+        let kept = vis.kept(ti);
+        let mut cur: Option<(Side, Category, Vec<usize>)> = None;
+        let flush = |cur: &mut Option<(Side, Category, Vec<usize>)>, out: &mut Vec<EdgeLine>| {
+            if let Some((side, cat, idx)) = cur.take() {
+                if idx.len() >= 2 {
+                    let mut hs: Vec<f64> = idx.iter().map(|&i| toe.h_curb[i]).collect();
+                    hs.sort_by(f64::total_cmp);
+                    out.push(EdgeLine {
+                        points: idx
+                            .iter()
+                            .map(|&i| {
+                                let p = toe.pts[i];
+                                [
+                                    p[0] + origin[0],
+                                    p[1] + origin[1],
+                                    ground.base.at(p[0], p[1]) + origin[2],
+                                ]
+                            })
+                            .collect(),
+                        side,
+                        category: Some(cat),
+                        method: None,
+                        curb_height_m: Some(hs[hs.len() / 2]),
+                    });
+                }
+            }
+        };
+        for v in 0..toe.pts.len().saturating_sub(1) {
+            if !(kept[v] && kept[v + 1]) {
+                flush(&mut cur, &mut out);
+                continue;
+            }
+            let (ca, cb) = (toe.category[v], toe.category[v + 1]);
+            let cat = if ca == cb || cb == Category::Curb {
+                ca
+            } else {
+                cb
+            };
+            let mid = [
+                0.5 * (toe.pts[v][0] + toe.pts[v + 1][0]),
+                0.5 * (toe.pts[v][1] + toe.pts[v + 1][1]),
+            ];
+            let side = side_of(mid);
+            match &mut cur {
+                Some((s, c, idx)) if *s == side && *c == cat => idx.push(v + 1),
+                _ => {
+                    flush(&mut cur, &mut out);
+                    cur = Some((side, cat, vec![v, v + 1]));
+                }
+            }
+        }
+        flush(&mut cur, &mut out);
+    }
+    out
+}

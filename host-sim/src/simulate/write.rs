@@ -1,0 +1,146 @@
+//! Writers: `points.laz` (LAS 1.4, point format 6, 1 mm scale, CRS offsets, WKT CRS VLR)
+//! and `trajectory.csv` (SPEC §3).
+
+use super::scanner::Return;
+use super::SimError;
+use crate::io::trajectory::Trajectory;
+use std::io::Write;
+use std::path::Path;
+
+/// LAS scan angle unit, degrees.
+const SCAN_ANGLE_UNIT: f64 = 0.006;
+
+/// WKT of the CRS for the EPSG codes the scenes use.
+pub fn wkt_for(epsg: u32) -> Option<String> {
+    let zone_cm = match epsg {
+        6691 => (54, 141),
+        6690 => (53, 135),
+        6692 => (55, 147),
+        _ => return None,
+    };
+    Some(format!(
+        "PROJCS[\"JGD2011 / UTM zone {z}N\",GEOGCS[\"JGD2011\",DATUM[\"Japanese_Geodetic_Datum_2011\",\
+SPHEROID[\"GRS 1980\",6378137,298.257222101,AUTHORITY[\"EPSG\",\"7019\"]],AUTHORITY[\"EPSG\",\"1128\"]],\
+PRIMEM[\"Greenwich\",0,AUTHORITY[\"EPSG\",\"8901\"]],UNIT[\"degree\",0.0174532925199433,AUTHORITY[\"EPSG\",\"9122\"]],\
+AUTHORITY[\"EPSG\",\"6668\"]],PROJECTION[\"Transverse_Mercator\"],PARAMETER[\"latitude_of_origin\",0],\
+PARAMETER[\"central_meridian\",{cm}],PARAMETER[\"scale_factor\",0.9996],PARAMETER[\"false_easting\",500000],\
+PARAMETER[\"false_northing\",0],UNIT[\"metre\",1,AUTHORITY[\"EPSG\",\"9001\"]],AXIS[\"Easting\",EAST],\
+AXIS[\"Northing\",NORTH],AUTHORITY[\"EPSG\",\"{epsg}\"]]",
+        z = zone_cm.0,
+        cm = zone_cm.1
+    ))
+}
+
+/// The value to hand to `las` so that its truncating conversion
+/// (`(deg / 0.006) as i16`) yields the *rounded* count: half a unit further from zero.
+pub fn scan_angle_for_las(deg: f64) -> f32 {
+    let n = (deg / SCAN_ANGLE_UNIT).round().clamp(-30000.0, 30000.0);
+    let nudged = if n == 0.0 { 0.0 } else { n + 0.5 * n.signum() };
+    (nudged * SCAN_ANGLE_UNIT) as f32
+}
+
+/// Writes the returns (scene-local + `origin`) as LAS 1.4 format 6; LAZ when the path ends
+/// in `.laz`.
+pub fn write_points(
+    path: &Path,
+    returns: &[Return],
+    origin: [f64; 3],
+    epsg: u32,
+) -> Result<(), SimError> {
+    let err = |e: las::Error| SimError::Write {
+        path: path.display().to_string(),
+        what: e.to_string(),
+    };
+    let mut b = las::Builder::from(las::Version::new(1, 4));
+    b.point_format = las::point::Format::new(6).map_err(err)?;
+    b.generating_software = "curbtrace simulate".into();
+    b.system_identifier = "curbtrace scene simulator".into();
+    b.gps_time_type = las::GpsTimeType::Standard;
+    // Offsets: the scene origin rounded to whole metres, scale 1 mm.
+    b.transforms = las::Vector {
+        x: las::Transform {
+            scale: 0.001,
+            offset: origin[0].floor(),
+        },
+        y: las::Transform {
+            scale: 0.001,
+            offset: origin[1].floor(),
+        },
+        z: las::Transform {
+            scale: 0.001,
+            offset: 0.0,
+        },
+    };
+    let mut header = b.into_header().map_err(err)?;
+    if let Some(wkt) = wkt_for(epsg) {
+        header.set_wkt_crs(wkt.into_bytes()).map_err(err)?;
+    }
+    let mut w = las::Writer::from_path(path, header).map_err(err)?;
+    for r in returns {
+        let p = las::Point {
+            x: r.p[0] + origin[0],
+            y: r.p[1] + origin[1],
+            z: r.p[2] + origin[2],
+            intensity: r.intensity,
+            return_number: 1,
+            number_of_returns: 1,
+            scanner_channel: 0,
+            scan_angle: scan_angle_for_las(r.scan_angle_deg),
+            point_source_id: 1,
+            gps_time: Some(r.t),
+            ..Default::default()
+        };
+        w.write_point(p).map_err(err)?;
+    }
+    w.close().map_err(err)?;
+    Ok(())
+}
+
+/// Writes `time,x,y,z,roll,pitch,heading` (SPEC §3), positions + `origin`.
+pub fn write_trajectory(path: &Path, traj: &Trajectory, origin: [f64; 3]) -> Result<(), SimError> {
+    let io = |source: std::io::Error| SimError::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let f = std::fs::File::create(path).map_err(io)?;
+    let mut w = std::io::BufWriter::new(f);
+    writeln!(w, "time,x,y,z,roll,pitch,heading").map_err(io)?;
+    for s in &traj.samples {
+        writeln!(
+            w,
+            "{:.6},{:.4},{:.4},{:.4},{:.5},{:.5},{:.5}",
+            s.t,
+            s.x + origin[0],
+            s.y + origin[1],
+            s.z + origin[2],
+            s.roll_deg,
+            s.pitch_deg,
+            s.heading_deg
+        )
+        .map_err(io)?;
+    }
+    w.flush().map_err(io)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scan_angle_survives_the_las_truncation_rounded() {
+        // 0.0179 / 0.006 = 2.98: rounding gives 3 units; plain truncation would give 2.
+        for (deg, units) in [
+            (0.0179, 3i16),
+            (-0.0179, -3),
+            (0.0, 0),
+            (179.91, 29985),
+            (-180.0, -30000),
+            (0.002, 0),
+        ] {
+            let v = scan_angle_for_las(deg);
+            let got = las::raw::point::ScanAngle::from(v);
+            assert_eq!(i16::from(got), units, "{deg}");
+        }
+    }
+}
