@@ -115,6 +115,36 @@ impl Progress {
     }
 }
 
+/// CPU time (user + system, all threads) of this process so far, seconds, from
+/// `/proc/self/stat` (Linux; 0 elsewhere). On a shared machine wall time says little; CPU
+/// time per stage says where the work goes.
+pub fn process_cpu_s() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+    let Some(rest) = stat.rsplit(')').next() else {
+        return 0.0;
+    };
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    // rest starts at field 3 (state): field k is f[k - 3]. Linux clock ticks are 100 Hz.
+    (ticks(11) + ticks(12)) / 100.0
+}
+
+/// CPU seconds per stage (all threads), see [`process_cpu_s`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StageCpu {
+    /// Reading the point file.
+    pub read_s: f64,
+    /// Projection, encoding and the core.
+    pub core_s: f64,
+    /// Seeding, tracking, post-filters.
+    pub edges_s: f64,
+    /// Everything.
+    pub total_s: f64,
+}
+
 /// Wall time per stage, seconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StageTimes {
@@ -128,6 +158,8 @@ pub struct StageTimes {
     pub edges_s: f64,
     /// Everything.
     pub total_s: f64,
+    /// CPU time per stage.
+    pub cpu: StageCpu,
 }
 
 /// What the summary at the end reports.
@@ -167,7 +199,8 @@ impl Summary {
              scanlines          {lines}\n\
              candidates         {cand}\n\
              edges              {edges}, total length {len:.1} m\n\
-             time               {total:.2} s ({pts:.2} M points/s): read {r:.2} s, trajectory {t:.2} s, core {k:.2} s, edges {e:.2} s",
+             time               {total:.2} s ({pts:.2} M points/s): read {r:.2} s, trajectory {t:.2} s, core {k:.2} s, edges {e:.2} s\n\
+             cpu                {ctot:.2} s: read {cr:.2} s, core {ck:.2} s, edges {ce:.2} s",
             read = self.points_read(),
             file = self.las.points_in_file,
             path = self.las.path.display(),
@@ -187,6 +220,10 @@ impl Summary {
             t = self.times.trajectory_s,
             k = self.times.core_s,
             e = self.times.edges_s,
+            ctot = self.times.cpu.total_s,
+            cr = self.times.cpu.read_s,
+            ck = self.times.cpu.core_s,
+            ce = self.times.cpu.edges_s,
         )
     }
 }
@@ -232,6 +269,7 @@ pub fn load(
     let trajectory = Trajectory::read_csv(traj_path)?;
     times.trajectory_s = t0.elapsed().as_secs_f64();
     let t0 = Instant::now();
+    let c0 = process_cpu_s();
     progress.stage("reading", 0);
     let (mut cols, las) = las_in::read_points(
         points,
@@ -244,6 +282,7 @@ pub fn load(
         },
     )?;
     times.read_s = t0.elapsed().as_secs_f64();
+    times.cpu.read_s = process_cpu_s() - c0;
     let t0 = Instant::now();
     let cov = trajectory.coverage(&cols.t, traj_path, points)?;
     if cov.dropped() > 0 {
@@ -273,6 +312,7 @@ pub fn replay_file(
         what,
     })?;
     let t0 = Instant::now();
+    let c0 = process_cpu_s();
     progress.stage("core", columns.len() as u64);
     let kernel = run::run_kernel(&columns, &trajectory, &words, &cfg.replay, &|d| {
         progress.set(d)
@@ -282,6 +322,7 @@ pub fn replay_file(
         source,
     })?;
     times.core_s = t0.elapsed().as_secs_f64();
+    times.cpu.core_s = process_cpu_s() - c0;
     Ok(Replayed {
         columns,
         las,
@@ -317,6 +358,7 @@ pub fn extract_file_with(
     progress: &Progress,
 ) -> Result<ExtractResult, ExtractError> {
     let start = Instant::now();
+    let cpu0 = process_cpu_s();
     if opts.method != Method::Bend {
         return Err(ExtractError::Method(opts.method.as_str().into()));
     }
@@ -326,6 +368,7 @@ pub fn extract_file_with(
     r.columns.scan_angle_deg = Vec::new();
     r.columns.intensity = Vec::new();
     let t0 = Instant::now();
+    let c0 = process_cpu_s();
     progress.stage("edges", 0);
     let input = BendInput {
         x: &r.columns.x,
@@ -344,8 +387,10 @@ pub fn extract_file_with(
             .get_or_insert_with(|| Method::Bend.as_str().to_string());
     }
     r.times.edges_s = t0.elapsed().as_secs_f64();
+    r.times.cpu.edges_s = process_cpu_s() - c0;
     progress.finish();
     r.times.total_s = start.elapsed().as_secs_f64();
+    r.times.cpu.total_s = process_cpu_s() - cpu0;
     let summary = Summary {
         dropped_before_trajectory: r.dropped.0,
         dropped_after_trajectory: r.dropped.1,
