@@ -132,6 +132,20 @@ pub fn process_cpu_s() -> f64 {
     (ticks(11) + ticks(12)) / 100.0
 }
 
+/// Peak resident memory of this process so far (VmHWM of `/proc/self/status`), bytes; 0
+/// where unavailable.
+pub fn peak_rss_bytes() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|v| v.parse::<u64>().ok())
+        })
+        .map_or(0, |kb| kb * 1024)
+}
+
 /// CPU seconds per stage (all threads), see [`process_cpu_s`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StageCpu {
@@ -143,6 +157,8 @@ pub struct StageCpu {
     pub edges_s: f64,
     /// Everything.
     pub total_s: f64,
+    /// Peak resident memory at the end of reading, of the core, of the edges, bytes.
+    pub peak_rss: [u64; 3],
 }
 
 /// Wall time per stage, seconds.
@@ -193,6 +209,7 @@ impl Summary {
     pub fn to_text(&self) -> String {
         let c = &self.core;
         let pts_per_s = self.points_read() as f64 / self.times.total_s.max(1e-9);
+        let per = self.points_read().max(1) as f64;
         format!(
             "points read        {read} of {file} in {path}\n\
              dropped            {before} before and {after} after the trajectory, {trunc} in over-long lines, {lost} lost in the core, {irr} irregular (§2.4), {nn} without neighbours\n\
@@ -200,7 +217,8 @@ impl Summary {
              candidates         {cand}\n\
              edges              {edges}, total length {len:.1} m\n\
              time               {total:.2} s ({pts:.2} M points/s): read {r:.2} s, trajectory {t:.2} s, core {k:.2} s, edges {e:.2} s\n\
-             cpu                {ctot:.2} s: read {cr:.2} s, core {ck:.2} s, edges {ce:.2} s",
+             cpu                {ctot:.2} s: read {cr:.2} s, core {ck:.2} s, edges {ce:.2} s\n\
+             peak memory        {m0:.1} B/point after reading, {m1:.1} after the core, {m2:.1} after the edges",
             read = self.points_read(),
             file = self.las.points_in_file,
             path = self.las.path.display(),
@@ -224,6 +242,9 @@ impl Summary {
             cr = self.times.cpu.read_s,
             ck = self.times.cpu.core_s,
             ce = self.times.cpu.edges_s,
+            m0 = self.times.cpu.peak_rss[0] as f64 / per,
+            m1 = self.times.cpu.peak_rss[1] as f64 / per,
+            m2 = self.times.cpu.peak_rss[2] as f64 / per,
         )
     }
 }
@@ -283,6 +304,7 @@ pub fn load(
     )?;
     times.read_s = t0.elapsed().as_secs_f64();
     times.cpu.read_s = process_cpu_s() - c0;
+    times.cpu.peak_rss[0] = peak_rss_bytes();
     let t0 = Instant::now();
     let cov = trajectory.coverage(&cols.t, traj_path, points)?;
     if cov.dropped() > 0 {
@@ -323,6 +345,7 @@ pub fn replay_file(
     })?;
     times.core_s = t0.elapsed().as_secs_f64();
     times.cpu.core_s = process_cpu_s() - c0;
+    times.cpu.peak_rss[1] = peak_rss_bytes();
     Ok(Replayed {
         columns,
         las,
@@ -388,6 +411,7 @@ pub fn extract_file_with(
     }
     r.times.edges_s = t0.elapsed().as_secs_f64();
     r.times.cpu.edges_s = process_cpu_s() - c0;
+    r.times.cpu.peak_rss[2] = peak_rss_bytes();
     progress.finish();
     r.times.total_s = start.elapsed().as_secs_f64();
     r.times.cpu.total_s = process_cpu_s() - cpu0;
