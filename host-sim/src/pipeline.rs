@@ -277,13 +277,27 @@ pub struct Replayed {
     pub times: StageTimes,
 }
 
+/// The points inside the trajectory and the trajectory, as [`load`] returns them.
+pub struct Loaded {
+    /// The covered points, sorted by time.
+    pub columns: PointColumns,
+    /// Header information.
+    pub las: LasInfo,
+    /// The trajectory.
+    pub trajectory: Trajectory,
+    /// Points dropped before / after the trajectory.
+    pub dropped: (u64, u64),
+    /// Stage times so far.
+    pub times: StageTimes,
+}
+
 /// Reads the points and the trajectory and drops (and counts) the points outside it.
 pub fn load(
     points: &Path,
     traj_path: &Path,
     opts: &ExtractOptions,
     progress: &Progress,
-) -> Result<(PointColumns, LasInfo, Trajectory, (u64, u64), StageTimes), ExtractError> {
+) -> Result<Loaded, ExtractError> {
     let mut times = StageTimes::default();
     // The trajectory first: a bad trajectory fails in milliseconds, not after decoding.
     let t0 = Instant::now();
@@ -311,13 +325,13 @@ pub fn load(
         cols.keep_range(cov.start..cov.end);
     }
     times.trajectory_s += t0.elapsed().as_secs_f64();
-    Ok((
-        cols,
+    Ok(Loaded {
+        columns: cols,
         las,
         trajectory,
-        (cov.before as u64, cov.after as u64),
+        dropped: (cov.before as u64, cov.after as u64),
         times,
-    ))
+    })
 }
 
 /// [`load`], then the replay through the core.
@@ -328,7 +342,13 @@ pub fn replay_file(
     opts: &ExtractOptions,
     progress: &Progress,
 ) -> Result<Replayed, ExtractError> {
-    let (columns, las, trajectory, dropped, mut times) = load(points, traj_path, opts, progress)?;
+    let Loaded {
+        columns,
+        las,
+        trajectory,
+        dropped,
+        mut times,
+    } = load(points, traj_path, opts, progress)?;
     let words = cfg.kernel_words().map_err(|what| ConfigError::Kernel {
         path: PathBuf::from("(config)"),
         what,

@@ -38,7 +38,7 @@ use std::path::{Path, PathBuf};
 /// Points decoded per `fill_points` call: large enough for LAZ's parallel decoder (chunks of
 /// typically 50 000 points spread over the cores), small enough that the byte slab (at most
 /// 67 B per point for format 10 without extra bytes) stays a few tens of MB.
-pub const CHUNK_POINTS: u64 = 1 << 20;
+pub const CHUNK_POINTS: u64 = 1 << 18;
 
 /// The largest number of points one file may hand to the core: the wire's tag is the `u32`
 /// index into the columns and `u32::MAX` means "not processed" downstream.
