@@ -115,6 +115,52 @@ impl Progress {
     }
 }
 
+/// CPU time (user + system, all threads) of this process so far, seconds, from
+/// `/proc/self/stat` (Linux; 0 elsewhere). On a shared machine wall time says little; CPU
+/// time per stage says where the work goes.
+pub fn process_cpu_s() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+    let Some(rest) = stat.rsplit(')').next() else {
+        return 0.0;
+    };
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
+    // rest starts at field 3 (state): field k is f[k - 3]. Linux clock ticks are 100 Hz.
+    (ticks(11) + ticks(12)) / 100.0
+}
+
+/// Peak resident memory of this process so far (VmHWM of `/proc/self/status`), bytes; 0
+/// where unavailable.
+pub fn peak_rss_bytes() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|v| v.parse::<u64>().ok())
+        })
+        .map_or(0, |kb| kb * 1024)
+}
+
+/// CPU seconds per stage (all threads), see [`process_cpu_s`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StageCpu {
+    /// Reading the point file.
+    pub read_s: f64,
+    /// Projection, encoding and the core.
+    pub core_s: f64,
+    /// Seeding, tracking, post-filters.
+    pub edges_s: f64,
+    /// Everything.
+    pub total_s: f64,
+    /// Peak resident memory at the end of reading, of the core, of the edges, bytes.
+    pub peak_rss: [u64; 3],
+}
+
 /// Wall time per stage, seconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StageTimes {
@@ -128,6 +174,8 @@ pub struct StageTimes {
     pub edges_s: f64,
     /// Everything.
     pub total_s: f64,
+    /// CPU time per stage.
+    pub cpu: StageCpu,
 }
 
 /// What the summary at the end reports.
@@ -161,13 +209,16 @@ impl Summary {
     pub fn to_text(&self) -> String {
         let c = &self.core;
         let pts_per_s = self.points_read() as f64 / self.times.total_s.max(1e-9);
+        let per = self.points_read().max(1) as f64;
         format!(
             "points read        {read} of {file} in {path}\n\
              dropped            {before} before and {after} after the trajectory, {trunc} in over-long lines, {lost} lost in the core, {irr} irregular (§2.4), {nn} without neighbours\n\
              scanlines          {lines}\n\
              candidates         {cand}\n\
              edges              {edges}, total length {len:.1} m\n\
-             time               {total:.2} s ({pts:.2} M points/s): read {r:.2} s, trajectory {t:.2} s, core {k:.2} s, edges {e:.2} s",
+             time               {total:.2} s ({pts:.2} M points/s): read {r:.2} s, trajectory {t:.2} s, core {k:.2} s, edges {e:.2} s\n\
+             cpu                {ctot:.2} s: read {cr:.2} s, core {ck:.2} s, edges {ce:.2} s\n\
+             peak memory        {m0:.1} B/point after reading, {m1:.1} after the core, {m2:.1} after the edges",
             read = self.points_read(),
             file = self.las.points_in_file,
             path = self.las.path.display(),
@@ -187,6 +238,13 @@ impl Summary {
             t = self.times.trajectory_s,
             k = self.times.core_s,
             e = self.times.edges_s,
+            ctot = self.times.cpu.total_s,
+            cr = self.times.cpu.read_s,
+            ck = self.times.cpu.core_s,
+            ce = self.times.cpu.edges_s,
+            m0 = self.times.cpu.peak_rss[0] as f64 / per,
+            m1 = self.times.cpu.peak_rss[1] as f64 / per,
+            m2 = self.times.cpu.peak_rss[2] as f64 / per,
         )
     }
 }
@@ -219,19 +277,34 @@ pub struct Replayed {
     pub times: StageTimes,
 }
 
+/// The points inside the trajectory and the trajectory, as [`load`] returns them.
+pub struct Loaded {
+    /// The covered points, sorted by time.
+    pub columns: PointColumns,
+    /// Header information.
+    pub las: LasInfo,
+    /// The trajectory.
+    pub trajectory: Trajectory,
+    /// Points dropped before / after the trajectory.
+    pub dropped: (u64, u64),
+    /// Stage times so far.
+    pub times: StageTimes,
+}
+
 /// Reads the points and the trajectory and drops (and counts) the points outside it.
 pub fn load(
     points: &Path,
     traj_path: &Path,
     opts: &ExtractOptions,
     progress: &Progress,
-) -> Result<(PointColumns, LasInfo, Trajectory, (u64, u64), StageTimes), ExtractError> {
+) -> Result<Loaded, ExtractError> {
     let mut times = StageTimes::default();
     // The trajectory first: a bad trajectory fails in milliseconds, not after decoding.
     let t0 = Instant::now();
     let trajectory = Trajectory::read_csv(traj_path)?;
     times.trajectory_s = t0.elapsed().as_secs_f64();
     let t0 = Instant::now();
+    let c0 = process_cpu_s();
     progress.stage("reading", 0);
     let (mut cols, las) = las_in::read_points(
         points,
@@ -244,19 +317,21 @@ pub fn load(
         },
     )?;
     times.read_s = t0.elapsed().as_secs_f64();
+    times.cpu.read_s = process_cpu_s() - c0;
+    times.cpu.peak_rss[0] = peak_rss_bytes();
     let t0 = Instant::now();
     let cov = trajectory.coverage(&cols.t, traj_path, points)?;
     if cov.dropped() > 0 {
         cols.keep_range(cov.start..cov.end);
     }
     times.trajectory_s += t0.elapsed().as_secs_f64();
-    Ok((
-        cols,
+    Ok(Loaded {
+        columns: cols,
         las,
         trajectory,
-        (cov.before as u64, cov.after as u64),
+        dropped: (cov.before as u64, cov.after as u64),
         times,
-    ))
+    })
 }
 
 /// [`load`], then the replay through the core.
@@ -267,12 +342,19 @@ pub fn replay_file(
     opts: &ExtractOptions,
     progress: &Progress,
 ) -> Result<Replayed, ExtractError> {
-    let (columns, las, trajectory, dropped, mut times) = load(points, traj_path, opts, progress)?;
+    let Loaded {
+        columns,
+        las,
+        trajectory,
+        dropped,
+        mut times,
+    } = load(points, traj_path, opts, progress)?;
     let words = cfg.kernel_words().map_err(|what| ConfigError::Kernel {
         path: PathBuf::from("(config)"),
         what,
     })?;
     let t0 = Instant::now();
+    let c0 = process_cpu_s();
     progress.stage("core", columns.len() as u64);
     let kernel = run::run_kernel(&columns, &trajectory, &words, &cfg.replay, &|d| {
         progress.set(d)
@@ -282,6 +364,8 @@ pub fn replay_file(
         source,
     })?;
     times.core_s = t0.elapsed().as_secs_f64();
+    times.cpu.core_s = process_cpu_s() - c0;
+    times.cpu.peak_rss[1] = peak_rss_bytes();
     Ok(Replayed {
         columns,
         las,
@@ -317,6 +401,7 @@ pub fn extract_file_with(
     progress: &Progress,
 ) -> Result<ExtractResult, ExtractError> {
     let start = Instant::now();
+    let cpu0 = process_cpu_s();
     if opts.method != Method::Bend {
         return Err(ExtractError::Method(opts.method.as_str().into()));
     }
@@ -326,6 +411,7 @@ pub fn extract_file_with(
     r.columns.scan_angle_deg = Vec::new();
     r.columns.intensity = Vec::new();
     let t0 = Instant::now();
+    let c0 = process_cpu_s();
     progress.stage("edges", 0);
     let input = BendInput {
         x: &r.columns.x,
@@ -344,8 +430,11 @@ pub fn extract_file_with(
             .get_or_insert_with(|| Method::Bend.as_str().to_string());
     }
     r.times.edges_s = t0.elapsed().as_secs_f64();
+    r.times.cpu.edges_s = process_cpu_s() - c0;
+    r.times.cpu.peak_rss[2] = peak_rss_bytes();
     progress.finish();
     r.times.total_s = start.elapsed().as_secs_f64();
+    r.times.cpu.total_s = process_cpu_s() - cpu0;
     let summary = Summary {
         dropped_before_trajectory: r.dropped.0,
         dropped_after_trajectory: r.dropped.1,

@@ -24,3 +24,49 @@ fn write_bench_scene() {
     assert_eq!(n, m);
     eprintln!("{n} points in {}", dir.display());
 }
+
+/// Decompresses `$CURBTRACE_LAZ` to `$CURBTRACE_LAS` (the simulator writes LAZ only; the
+/// benchmark reads both):
+///
+/// ```sh
+/// CURBTRACE_LAZ=kawasaki/points.laz CURBTRACE_LAS=kawasaki/points.las \
+///   cargo test --release -p curbtrace-host-sim --test bench_scene -- --ignored laz_to_las
+/// ```
+#[test]
+#[ignore]
+fn laz_to_las() {
+    let (Ok(src), Ok(dst)) = (
+        std::env::var("CURBTRACE_LAZ"),
+        std::env::var("CURBTRACE_LAS"),
+    ) else {
+        eprintln!("set CURBTRACE_LAZ and CURBTRACE_LAS");
+        return;
+    };
+    let mut r = las::Reader::from_path(&src).unwrap();
+    let mut h = r.header().clone().into_raw().unwrap();
+    h.point_data_record_format &= 0x3f;
+    let mut header = las::Header::from_raw(h).unwrap();
+    // Drop the LASzip VLR: the copy is uncompressed.
+    let mut b = las::Builder::new(header.clone().into_raw().unwrap()).unwrap();
+    b.vlrs = header
+        .vlrs()
+        .iter()
+        .filter(|v| v.user_id != "laszip encoded")
+        .cloned()
+        .collect();
+    b.point_format.is_compressed = false;
+    header = b.into_header().unwrap();
+    let mut w = las::Writer::from_path(&dst, header).unwrap();
+    let mut pd = las::PointDataBuilder::new().for_header(r.header()).build();
+    let mut n = 0u64;
+    while r.fill_points(1 << 20, &mut pd).unwrap() > 0 {
+        n += pd.len() as u64;
+        let out = las::PointDataBuilder::new()
+            .for_header(w.header())
+            .build_from_bytes(pd.raw_bytes().to_vec())
+            .unwrap();
+        w.write_points(&out).unwrap();
+    }
+    w.close().unwrap();
+    eprintln!("{n} points to {dst}");
+}

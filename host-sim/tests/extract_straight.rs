@@ -102,4 +102,12 @@ fn library_and_laz_give_the_same_edges() {
     let c = curbtrace_host_sim::pipeline::extract_file(&las, &traj, &small).unwrap();
     assert_eq!(a.edges, c.edges);
     assert!(c.summary.core.scanlines == a.summary.core.scanlines);
+    // One thread gives the same edges as the default pool.
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let d =
+        one.install(|| curbtrace_host_sim::pipeline::extract_file(&las, &traj, &small).unwrap());
+    assert_eq!(a.edges, d.edges);
 }

@@ -38,7 +38,7 @@ use std::path::{Path, PathBuf};
 /// Points decoded per `fill_points` call: large enough for LAZ's parallel decoder (chunks of
 /// typically 50 000 points spread over the cores), small enough that the byte slab (at most
 /// 67 B per point for format 10 without extra bytes) stays a few tens of MB.
-pub const CHUNK_POINTS: u64 = 1 << 20;
+pub const CHUNK_POINTS: u64 = 1 << 18;
 
 /// The largest number of points one file may hand to the core: the wire's tag is the `u32`
 /// index into the columns and `u32::MAX` means "not processed" downstream.
@@ -487,8 +487,6 @@ pub fn read_points(
         (Some(_), true) => None,
     };
     let mut done: u64 = 0;
-    let mut first_sa: Option<f32> = None;
-    let mut has_scan_angle = false;
     loop {
         let n = reader
             .fill_points(CHUNK_POINTS, &mut pd)
@@ -522,6 +520,23 @@ pub fn read_points(
                 format: head.format,
             });
         };
+        if sel == ScannerSelection::All {
+            // Every point kept: fill the six columns in parallel straight from the slab.
+            let bad_t = decode_all_parallel(raw, record_len, extended, pd.transforms(), &mut cols);
+            if let Some(k) = bad_t {
+                return Err(LasError::BadTime {
+                    path: path.to_path_buf(),
+                    index: done + k as u64,
+                    t: cols.t[cols.t.len() - n as usize + k],
+                });
+            }
+            done += n;
+            progress(done, total);
+            if done >= total {
+                break;
+            }
+            continue;
+        }
         let keep_rec = |rec: &[u8], psid: u16| match sel {
             ScannerSelection::All => true,
             ScannerSelection::Channel(c) => channel_of(rec) == c,
@@ -542,11 +557,6 @@ pub fn read_points(
                     index: done + k as u64,
                     t,
                 });
-            }
-            match first_sa {
-                None => first_sa = Some(sa),
-                Some(f) if f != sa => has_scan_angle = true,
-                _ => {}
             }
             cols.x.push(x);
             cols.y.push(y);
@@ -606,6 +616,10 @@ pub fn read_points(
         });
     }
     cols.shrink_to_fit();
+    let has_scan_angle = cols
+        .scan_angle_deg
+        .first()
+        .is_some_and(|&a| cols.scan_angle_deg.iter().any(|&b| b != a));
     let was_sorted = !cols.sort_by_time();
     let info = LasInfo {
         path: path.to_path_buf(),
@@ -620,6 +634,80 @@ pub fn read_points(
         has_scan_angle,
     };
     Ok((cols, info))
+}
+
+/// Appends the `raw` records to `cols`, one column per rayon task, decoding the fields at
+/// their LAS offsets (x, y, z at 0, 4, 8; intensity at 12; legacy formats: scan angle rank
+/// i8 at 16, GPS time at 20; formats 6–10: scan angle i16 × 0.006° at 18, GPS time at 22).
+/// Returns the index within `raw` of the first point whose time is not finite.
+fn decode_all_parallel(
+    raw: &[u8],
+    record_len: usize,
+    extended: bool,
+    tr: &las::Vector<las::Transform>,
+    cols: &mut PointColumns,
+) -> Option<usize> {
+    let n = raw.len() / record_len;
+    let base = cols.len();
+    let recs = || raw.chunks_exact(record_len);
+    let i32_at = |r: &[u8], o: usize| i32::from_le_bytes([r[o], r[o + 1], r[o + 2], r[o + 3]]);
+    let gps_at = if extended { 22 } else { 20 };
+    cols.x.resize(base + n, 0.0);
+    cols.y.resize(base + n, 0.0);
+    cols.z.resize(base + n, 0.0);
+    cols.t.resize(base + n, 0.0);
+    cols.intensity.resize(base + n, 0);
+    cols.scan_angle_deg.resize(base + n, 0.0);
+    let mut bad_t = None;
+    let PointColumns {
+        x,
+        y,
+        z,
+        t,
+        intensity,
+        scan_angle_deg,
+    } = cols;
+    rayon::scope(|s| {
+        s.spawn(|_| {
+            for (v, r) in x[base..].iter_mut().zip(recs()) {
+                *v = tr.x.direct(i32_at(r, 0));
+            }
+        });
+        s.spawn(|_| {
+            for (v, r) in y[base..].iter_mut().zip(recs()) {
+                *v = tr.y.direct(i32_at(r, 4));
+            }
+        });
+        s.spawn(|_| {
+            for (v, r) in z[base..].iter_mut().zip(recs()) {
+                *v = tr.z.direct(i32_at(r, 8));
+            }
+        });
+        s.spawn(|_| {
+            for (v, r) in intensity[base..].iter_mut().zip(recs()) {
+                *v = u16::from_le_bytes([r[12], r[13]]);
+            }
+            for (v, r) in scan_angle_deg[base..].iter_mut().zip(recs()) {
+                *v = if extended {
+                    f32::from(i16::from_le_bytes([r[18], r[19]])) * 0.006
+                } else {
+                    f32::from(r[16] as i8)
+                };
+            }
+        });
+        let bad = &mut bad_t;
+        s.spawn(move |_| {
+            for (k, (v, r)) in t[base..].iter_mut().zip(recs()).enumerate() {
+                let mut b = [0u8; 8];
+                b.copy_from_slice(&r[gps_at..gps_at + 8]);
+                *v = f64::from_le_bytes(b);
+                if !v.is_finite() && bad.is_none() {
+                    *bad = Some(k);
+                }
+            }
+        });
+    });
+    bad_t
 }
 
 /// Maps a `las` crate error to a one-line message naming the file, the stage, and whether

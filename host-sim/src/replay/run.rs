@@ -229,7 +229,7 @@ pub struct KernelResults {
 pub fn chunks(cols: &PointColumns, rule: &LineRule, chunk_points: usize) -> Vec<Range<usize>> {
     let n = cols.len();
     if !rule.flags_lines() || n == 0 {
-        return vec![0..n];
+        return std::iter::once(0..n).collect();
     }
     let mut out = Vec::new();
     let mut a = 0;
@@ -319,16 +319,22 @@ struct ChunkOut {
     counters: ReplayCounters,
 }
 
+/// A chunk's share of the per-point outputs.
+struct ChunkSlices<'a> {
+    rho: &'a mut [f32],
+    status: &'a mut [u8],
+    line: &'a mut [u32],
+}
+
 fn run_chunk(
     cols: &PointColumns,
     range: Range<usize>,
     traj: &Trajectory,
     words: &[u32; CONFIG_WORDS],
     rule: &LineRule,
-    rho: &mut [f32],
-    status: &mut [u8],
-    line: &mut [u32],
+    slices: ChunkSlices<'_>,
 ) -> Result<ChunkOut, ReplayError> {
+    let ChunkSlices { rho, status, line } = slices;
     let start = range.start;
     let mut pipe: Box<HostPipeline> = Box::default();
     let mut out = ChunkOut {
@@ -429,7 +435,18 @@ pub fn run_kernel(
             .into_par_iter()
             .map(|(rg, r, s, l)| {
                 let len = rg.len() as u64;
-                let o = run_chunk(cols, rg, traj, words, &rule, r, s, l);
+                let o = run_chunk(
+                    cols,
+                    rg,
+                    traj,
+                    words,
+                    &rule,
+                    ChunkSlices {
+                        rho: r,
+                        status: s,
+                        line: l,
+                    },
+                );
                 let d = done.fetch_add(len, std::sync::atomic::Ordering::Relaxed) + len;
                 progress(d);
                 o
