@@ -41,7 +41,9 @@ fn bend(p: &[[f64; 2]], w: &[(usize, usize)]) -> Vec<Option<f64>> {
             }
             let a = [p[i][0] - p[s][0], p[i][1] - p[s][1]];
             let b = [p[t][0] - p[i][0], p[t][1] - p[i][1]];
-            let ang = (a[0] * b[1] - a[1] * b[0]).atan2(a[0] * b[0] + a[1] * b[1]).abs();
+            let ang = (a[0] * b[1] - a[1] * b[0])
+                .atan2(a[0] * b[0] + a[1] * b[1])
+                .abs();
             // Sign: + when i and the scanner (origin) are on opposite sides of chord s–t.
             let c = [p[t][0] - p[s][0], p[t][1] - p[s][1]];
             let side_i = c[0] * (p[i][1] - p[s][1]) - c[1] * (p[i][0] - p[s][0]);
@@ -72,7 +74,8 @@ fn kernel_line(raw: &[[f64; 2]]) -> (Vec<f32>, Vec<u8>, Option<usize>, Option<us
         let q = p.clone();
         for k in 1..p.len().saturating_sub(1) {
             for c in 0..2 {
-                p[k][c] = q[k][c] + lam * (0.5 * (q[k - 1][c] - q[k][c]) + 0.5 * (q[k + 1][c] - q[k][c]));
+                p[k][c] =
+                    q[k][c] + lam * (0.5 * (q[k - 1][c] - q[k][c]) + 0.5 * (q[k + 1][c] - q[k][c]));
             }
         }
     }
@@ -123,8 +126,12 @@ fn devrun() {
         return;
     };
     let dir = std::path::PathBuf::from(dir);
-    let (cols, _) = read_points(&dir.join("points.laz"), &ReadOptions::default(), &mut |_, _| {})
-        .unwrap();
+    let (cols, _) = read_points(
+        &dir.join("points.laz"),
+        &ReadOptions::default(),
+        &mut |_, _| {},
+    )
+    .unwrap();
     let traj = Trajectory::read_csv(&dir.join("trajectory.csv")).unwrap();
     let params: BendParams = std::env::var("BEND_CONFIG")
         .ok()
@@ -132,8 +139,123 @@ fn devrun() {
         .unwrap_or_default();
     let t0 = std::time::Instant::now();
     let n = cols.len();
+    let cache = dir.join("standin_kernel.bin");
+    let (rho, status, scanline, candidates, line) = match std::fs::read(&cache) {
+        Ok(b) if b.len() >= 8 * n => read_cache(&b, n),
+        _ => {
+            let r = standin_kernel(&cols, &traj);
+            std::fs::write(&cache, write_cache(&r)).unwrap();
+            r
+        }
+    };
+    let t1 = t0.elapsed().as_secs_f64();
+    let input = BendInput {
+        x: &cols.x,
+        y: &cols.y,
+        z: &cols.z,
+        t: &cols.t,
+        rho_deg: &rho,
+        status: &status,
+        scanline: &scanline,
+        candidates: &candidates,
+        trajectory: &traj,
+    };
+    if std::env::var("BEND_STAGES").is_ok() {
+        let p = &params;
+        let s0 = std::time::Instant::now();
+        let route = route::Route::new(&traj);
+        let grid = grid::PointGrid::build(input.x, input.y, 0.1, |i| input.status[i] != 255);
+        let a = s0.elapsed().as_secs_f64();
+        let seeds = seed::seed_points(&input, &route, p);
+        let b = s0.elapsed().as_secs_f64();
+        let tracks = track::track_edges(&input, &grid, &seeds, p);
+        let c = s0.elapsed().as_secs_f64();
+        let mut lens: Vec<(usize, f64)> = tracks
+            .iter()
+            .map(|t| (t.points.len(), postfilter::track_length_m(&input, t)))
+            .collect();
+        lens.sort_by(|a, b| b.0.cmp(&a.0));
+        eprintln!(
+            "{} tracks, longest (points, m): {:?}",
+            lens.len(),
+            &lens[..lens.len().min(30)]
+        );
+        let tracks = postfilter::remove_short(&input, tracks, p);
+        let tracks = postfilter::remove_under_objects(&input, &grid, tracks, p);
+        let d = s0.elapsed().as_secs_f64();
+        let tracks = postfilter::remove_outside_roadway(&input, &route, tracks);
+        let e = s0.elapsed().as_secs_f64();
+        let _ = postfilter::to_edge_lines(&input, &grid, &route, &tracks, p);
+        let f = s0.elapsed().as_secs_f64();
+        eprintln!(
+            "index {a:.3} seeds {:.3} ({} seeds) track {:.3} short+vehicle {:.3} roadway {:.3} lines {:.3}",
+            b - a,
+            seeds.len(),
+            c - b,
+            d - c,
+            e - d,
+            f - e
+        );
+    }
+    let t1 = t0.elapsed().as_secs_f64();
+    let edges = extract_edges(&input, &params);
+    let t2 = t0.elapsed().as_secs_f64();
+    eprintln!(
+        "{n} points, {line} lines, {} candidates, {} edges; stand-in kernel {t1:.2} s, bend {:.2} s",
+        candidates.len(),
+        edges.len(),
+        t2 - t1
+    );
+    crate::model::write_geojson(&dir.join("edges.geojson"), &edges, None).unwrap();
+}
+
+type KernelOut = (Vec<f32>, Vec<u8>, Vec<u32>, Vec<Candidate>, u32);
+
+fn write_cache(r: &KernelOut) -> Vec<u8> {
+    let mut b = Vec::new();
+    for v in &r.0 {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    b.extend_from_slice(&r.1);
+    for v in &r.2 {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    b.extend_from_slice(&r.4.to_le_bytes());
+    for c in &r.3 {
+        b.extend_from_slice(&c.point.to_le_bytes());
+        b.extend_from_slice(&c.scanline.to_le_bytes());
+        b.push(matches!(c.side, Side::Right) as u8);
+    }
+    b
+}
+
+fn read_cache(b: &[u8], n: usize) -> KernelOut {
+    let u32_at = |o: usize| u32::from_le_bytes(b[o..o + 4].try_into().unwrap());
+    let rho = (0..n).map(|i| f32::from_bits(u32_at(4 * i))).collect();
+    let status = b[4 * n..5 * n].to_vec();
+    let scanline = (0..n).map(|i| u32_at(5 * n + 4 * i)).collect();
+    let line = u32_at(9 * n);
+    let mut c = Vec::new();
+    let mut o = 9 * n + 4;
+    while o + 9 <= b.len() {
+        c.push(Candidate {
+            point: u32_at(o),
+            scanline: u32_at(o + 4),
+            side: if b[o + 8] == 1 {
+                Side::Right
+            } else {
+                Side::Left
+            },
+        });
+        o += 9;
+    }
+    (rho, status, scanline, c, line)
+}
+
+fn standin_kernel(cols: &crate::io::las_in::PointColumns, traj: &Trajectory) -> KernelOut {
+    let n = cols.len();
     let rule = LineRule::choose(&cols.scan_angle_deg, &cols.t, &LineStartParams::default());
-    let mut cur = PoseCursor::new(&traj);
+    let mut cur = PoseCursor::new(traj);
     let mut xz = vec![[f64::NAN; 2]; n];
     let mut ok = vec![false; n];
     for i in 0..n {
@@ -178,25 +300,5 @@ fn devrun() {
         }
         start = end;
     }
-    let t1 = t0.elapsed().as_secs_f64();
-    let input = BendInput {
-        x: &cols.x,
-        y: &cols.y,
-        z: &cols.z,
-        t: &cols.t,
-        rho_deg: &rho,
-        status: &status,
-        scanline: &scanline,
-        candidates: &candidates,
-        trajectory: &traj,
-    };
-    let edges = extract_edges(&input, &params);
-    let t2 = t0.elapsed().as_secs_f64();
-    eprintln!(
-        "{n} points, {line} lines, {} candidates, {} edges; stand-in kernel {t1:.2} s, bend {:.2} s",
-        candidates.len(),
-        edges.len(),
-        t2 - t1
-    );
-    crate::model::write_geojson(&dir.join("edges.geojson"), &edges, None).unwrap();
+    (rho, status, scanline, candidates, line)
 }
