@@ -67,7 +67,11 @@ impl Config {
         })?;
         let cfg: Config = toml::from_str(&text).map_err(|e| ConfigError::Parse {
             path: path.to_path_buf(),
-            what: e.to_string().split_whitespace().collect::<Vec<_>>().join(" "),
+            what: e
+                .to_string()
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" "),
         })?;
         cfg.kernel_words().map_err(|what| ConfigError::Kernel {
             path: path.to_path_buf(),
@@ -92,12 +96,34 @@ impl Config {
 }
 
 /// The `[kernel]` table: a serde mirror of `curbtrace_core::kernel::KernelParams` (the core
-/// is `no_std` without serde). Defaults are the core's `KernelParams::DEFAULT`.
+/// is `no_std` without serde); each field's meaning and default are documented there.
+/// Defaults are the core's `KernelParams::DEFAULT`; the values go to the core in the
+/// stream's config packet and are checked by the core itself.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct KernelConfig {
-    /// d_b: neighbour distance for the bend angle, metres (§2.3).
+    /// d_b: neighbour distance of the bend angle, metres (§2.3).
     pub d_b_m: f32,
+    /// Irregular-point threshold on |ρ| of the raw line, degrees (§2.4).
+    pub irregular_deg: f32,
+    /// τ_min: lower bound of a peak's ρ, degrees (§2.6).
+    pub tau_min_deg: f32,
+    /// τ_max: upper bound of a peak's ρ, degrees (§2.6).
+    pub tau_max_deg: f32,
+    /// Taubin smoothing steps (§2.5).
+    pub taubin_steps: u32,
+    /// Taubin λ (§2.5).
+    pub taubin_lambda: f32,
+    /// Taubin μ (§2.5).
+    pub taubin_mu: f32,
+    /// Gap that splits a line into separately smoothed pieces, metres (0 = never).
+    pub smooth_gap_m: f32,
+    /// Assembly: pause that ends a line without flags, ns (0 = off).
+    pub split_gap_ns: u32,
+    /// Assembly: side change of x′ that splits a line when the jump exceeds this, metres.
+    pub split_jump_m: f32,
+    /// Assembly: side change above this z′ also splits, metres.
+    pub split_above_m: f32,
 }
 
 impl Default for KernelConfig {
@@ -109,14 +135,35 @@ impl Default for KernelConfig {
 impl KernelConfig {
     /// From the core's struct.
     pub fn from_params(p: &KernelParams) -> Self {
-        Self { d_b_m: p.d_b_m }
+        Self {
+            d_b_m: p.d_b_m,
+            irregular_deg: p.irregular_deg,
+            tau_min_deg: p.tau_min_deg,
+            tau_max_deg: p.tau_max_deg,
+            taubin_steps: p.taubin_steps,
+            taubin_lambda: p.taubin_lambda,
+            taubin_mu: p.taubin_mu,
+            smooth_gap_m: p.smooth_gap_m,
+            split_gap_ns: p.split_gap_ns,
+            split_jump_m: p.split_jump_m,
+            split_above_m: p.split_above_m,
+        }
     }
 
     /// To the core's struct.
     pub fn to_params(&self) -> KernelParams {
         KernelParams {
             d_b_m: self.d_b_m,
-            ..KernelParams::DEFAULT
+            irregular_deg: self.irregular_deg,
+            tau_min_deg: self.tau_min_deg,
+            tau_max_deg: self.tau_max_deg,
+            taubin_steps: self.taubin_steps,
+            taubin_lambda: self.taubin_lambda,
+            taubin_mu: self.taubin_mu,
+            smooth_gap_m: self.smooth_gap_m,
+            split_gap_ns: self.split_gap_ns,
+            split_jump_m: self.split_jump_m,
+            split_above_m: self.split_above_m,
         }
     }
 }
@@ -146,6 +193,9 @@ mod tests {
         assert_eq!(c.kernel, KernelConfig::default());
         std::fs::write(&p, "[replay]\nchunk_pionts = 1000\n").unwrap();
         let e = Config::read(&p).unwrap_err().to_string();
-        assert!(e.contains("c.toml") && e.contains("chunk_pionts") && !e.contains('\n'), "{e}");
+        assert!(
+            e.contains("c.toml") && e.contains("chunk_pionts") && !e.contains('\n'),
+            "{e}"
+        );
     }
 }

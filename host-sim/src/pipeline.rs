@@ -294,8 +294,18 @@ pub fn replay_file(
 
 /// Extracts road edges from a LAS/LAZ file and its trajectory with the bend method and all
 /// points of the file (one scanner).
-pub fn extract_file(points: &Path, traj: &Path, cfg: &Config) -> Result<ExtractResult, ExtractError> {
-    extract_file_with(points, traj, cfg, &ExtractOptions::default(), &Progress::hidden())
+pub fn extract_file(
+    points: &Path,
+    traj: &Path,
+    cfg: &Config,
+) -> Result<ExtractResult, ExtractError> {
+    extract_file_with(
+        points,
+        traj,
+        cfg,
+        &ExtractOptions::default(),
+        &Progress::hidden(),
+    )
 }
 
 /// [`extract_file`] with a scanner, a method and a progress display.
@@ -330,7 +340,8 @@ pub fn extract_file_with(
     };
     let mut edges = bend::extract_edges(&input, &cfg.bend);
     for e in &mut edges {
-        e.method.get_or_insert_with(|| Method::Bend.as_str().to_string());
+        e.method
+            .get_or_insert_with(|| Method::Bend.as_str().to_string());
     }
     r.times.edges_s = t0.elapsed().as_secs_f64();
     progress.finish();

@@ -200,3 +200,93 @@ fn trajectory_times_going_backwards() {
         "{e}"
     );
 }
+
+mod common;
+
+/// Runs `curbtrace extract` and returns (success, stderr).
+fn extract(points: &Path, traj: &Path, out: &Path) -> (bool, String) {
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_curbtrace"))
+        .arg("extract")
+        .arg(points)
+        .arg("--trajectory")
+        .arg(traj)
+        .arg("-o")
+        .arg(out)
+        .output()
+        .unwrap();
+    (
+        run.status.success(),
+        String::from_utf8_lossy(&run.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn cli_bad_inputs_exit_non_zero_with_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let road = common::Road {
+        length_m: 4.0,
+        ..Default::default()
+    };
+    let las = dir.path().join("road.las");
+    let traj = dir.path().join("trajectory.csv");
+    road.write(&las, &traj);
+    let out = dir.path().join("edges.geojson");
+    let junk = dir.path().join("junk.las");
+    std::fs::write(&junk, "hello").unwrap();
+    let bad_traj = dir.path().join("bad.csv");
+    std::fs::write(&bad_traj, "time,x,y\n1,2,3\n").unwrap();
+    // Trajectory in GPS week seconds against points in adjusted standard time.
+    let week = dir.path().join("week.csv");
+    std::fs::write(
+        &week,
+        "time,x,y,z,roll,pitch,heading\n300000,500000,4000000,2,0,0,0\n300010,500000,4000080,2,0,0,0\n",
+    )
+    .unwrap();
+    for (p, t, want) in [
+        (&junk, &traj, "not a LAS/LAZ file"),
+        (&las, &bad_traj, "bad header"),
+        (&las, &week, "GPS week seconds"),
+    ] {
+        let (ok, err) = extract(p, t, &out);
+        assert!(!ok, "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+        assert!(err.contains(want), "{err}");
+    }
+}
+
+#[test]
+fn points_partly_outside_the_trajectory_are_dropped_and_counted() {
+    use curbtrace_host_sim::pipeline::{load, ExtractOptions, Progress};
+    let dir = tempfile::tempdir().unwrap();
+    let road = common::Road {
+        length_m: 8.0,
+        ..Default::default()
+    };
+    let las = dir.path().join("road.las");
+    let traj = dir.path().join("trajectory.csv");
+    road.write(&las, &traj);
+    // Keep only the trajectory samples between 0.2 s and 0.7 s of the 1 s drive (samples
+    // are at 0.05 + 0.1 k s, so 0.25 … 0.65 s remain).
+    let text = std::fs::read_to_string(&traj).unwrap();
+    let mut lines = text.lines();
+    let mut cut = String::from(lines.next().unwrap());
+    cut.push('\n');
+    for l in lines {
+        let t: f64 = l.split(',').next().unwrap().parse().unwrap();
+        if (common::T0 + 0.2..=common::T0 + 0.7).contains(&t) {
+            cut.push_str(l);
+            cut.push('\n');
+        }
+    }
+    std::fs::write(&traj, cut).unwrap();
+    let (all, _) = read_points(&las, &ReadOptions::default(), &mut |_, _| {}).unwrap();
+    let (t0, t1) = (common::T0 + 0.25, common::T0 + 0.65);
+    let before = all.t.iter().filter(|&&t| t < t0).count() as u64;
+    let after = all.t.iter().filter(|&&t| t > t1).count() as u64;
+    assert!(before > 0 && after > 0);
+    let (cols, info, _, dropped, _) =
+        load(&las, &traj, &ExtractOptions::default(), &Progress::hidden()).unwrap();
+    assert_eq!(dropped, (before, after));
+    assert_eq!(cols.len() as u64 + before + after, info.points_selected);
+    assert!(cols.t.iter().all(|&t| (t0..=t1).contains(&t)));
+}

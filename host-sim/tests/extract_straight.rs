@@ -33,9 +33,19 @@ fn check_edges(geojson: &std::path::Path, road: &Road) {
         let rms = (sq / coords.len() as f64).sqrt();
         let len = p["length_m"].as_f64().unwrap();
         let h = p["curb_height_m"].as_f64().unwrap();
-        eprintln!("{side}: {} vertices, RMS {:.4} m, y {:.2}–{:.2}, length {len} m, height {h} m", coords.len(), rms, ymin - Y0, ymax - Y0);
+        eprintln!(
+            "{side}: {} vertices, RMS {:.4} m, y {:.2}–{:.2}, length {len} m, height {h} m",
+            coords.len(),
+            rms,
+            ymin - Y0,
+            ymax - Y0
+        );
         assert!(rms < 0.020, "{side} RMS {rms} m");
-        assert!(len > 0.8 * road.length_m, "{side} covers {len} of {} m", road.length_m);
+        assert!(
+            len > 0.8 * road.length_m,
+            "{side} covers {len} of {} m",
+            road.length_m
+        );
         assert!((h - road.curb_m).abs() < 0.03, "{side} height {h}");
         sides.push(side);
     }
@@ -64,7 +74,10 @@ fn extract_finds_both_toes_of_a_straight_road() {
     let stderr = String::from_utf8_lossy(&run.stderr);
     eprintln!("{stderr}");
     assert!(run.status.success(), "{stderr}");
-    assert!(stderr.contains("points read") && stderr.contains("edges"), "{stderr}");
+    assert!(
+        stderr.contains("points read") && stderr.contains("edges"),
+        "{stderr}"
+    );
     check_edges(&out, &road);
 }
 

@@ -64,10 +64,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         None => Config::default(),
     };
     if args.print_config {
-        print!("{}", toml::to_string_pretty(&cfg).context("printing the config")?);
+        print!(
+            "{}",
+            toml::to_string_pretty(&cfg).context("printing the config")?
+        );
         return Ok(());
     }
-    let (Some(points), Some(trajectory), Some(output)) = (&args.points, &args.trajectory, &args.output)
+    let (Some(points), Some(trajectory), Some(output)) =
+        (&args.points, &args.trajectory, &args.output)
     else {
         anyhow::bail!("POINTS, --trajectory and -o are required");
     };

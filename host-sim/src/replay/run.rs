@@ -21,8 +21,8 @@ use crate::bend::{Candidate, STATUS_NOT_PROCESSED};
 use crate::io::las_in::PointColumns;
 use crate::io::trajectory::Trajectory;
 use crate::model::Side;
-use curbtrace_core::kernel::{ScanlineOutput, CONFIG_WORDS};
-use curbtrace_core::pipeline::Pipeline;
+use curbtrace_core::kernel::{Kernel, KernelParams, ScanlineOutput, CONFIG_WORDS};
+use curbtrace_core::scanline::{Ingest, IngestCounters, IngestEvent};
 use curbtrace_core::wire::{PointRecord, StreamEncoder, MAX_PACKET_LEN, MAX_POINTS_PER_PACKET};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -31,11 +31,79 @@ use std::ops::Range;
 /// Capacity of the host pipeline's byte ring.
 pub const RING: usize = 1 << 16;
 /// Largest number of points of one scanline the host pipeline holds; more are counted as
-/// truncated by the core.
+/// truncated by the core. A 360° scanner at 1 M pulses/s and 100 lines/s gives 10 000
+/// pulses per line; the simulator's VQ-250-like scanner 2 000.
 pub const LINE_CAPACITY: usize = 16_384;
 
-/// The host's pipeline type.
-pub type HostPipeline = Pipeline<RING, LINE_CAPACITY>;
+/// Stack size of the threads that run pipelines.
+pub const PIPELINE_STACK: usize = 64 << 20;
+
+/// The core's ingest (ring, parser, assembler) and kernel, composed as
+/// `docs/architecture.md` documents `Pipeline<RING, N>`: bytes in, one
+/// [`ScanlineOutput`] per completed line out; a config packet reconfigures the kernel.
+pub struct HostPipeline {
+    ingest: Ingest<RING, LINE_CAPACITY>,
+    kernel: Kernel<LINE_CAPACITY>,
+    config_rejected: u64,
+}
+
+impl Default for HostPipeline {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl HostPipeline {
+    /// A pipeline with the kernel's defaults until a config packet arrives.
+    pub fn new() -> Self {
+        Self {
+            ingest: Ingest::new(),
+            kernel: Kernel::new(KernelParams::DEFAULT),
+            config_rejected: 0,
+        }
+    }
+
+    /// Offers bytes; returns how many the ring took.
+    pub fn write(&mut self, bytes: &[u8]) -> usize {
+        self.ingest.write(bytes)
+    }
+
+    /// Processes every complete line in the ring.
+    pub fn run(&mut self, mut on_line: impl FnMut(&ScanlineOutput<'_>)) {
+        while let Some(ev) = self.ingest.poll() {
+            match ev {
+                IngestEvent::Config(words) => {
+                    let ok = KernelParams::from_words(&words)
+                        .ok()
+                        .and_then(|p| self.kernel.set_params(p).ok());
+                    if ok.is_none() {
+                        self.config_rejected += 1;
+                    }
+                }
+                IngestEvent::Line(line) => {
+                    let out = self.kernel.process(line);
+                    on_line(&out);
+                }
+            }
+        }
+    }
+
+    /// End of stream: the partial last line is processed too.
+    pub fn finish(&mut self, on_line: impl FnMut(&ScanlineOutput<'_>)) {
+        self.ingest.finish();
+        self.run(on_line);
+    }
+
+    /// The ingest counters.
+    pub fn counters(&self) -> IngestCounters {
+        self.ingest.counters()
+    }
+
+    /// Config packets whose parameters the kernel refused (the old ones stayed).
+    pub fn config_rejected(&self) -> u64 {
+        self.config_rejected
+    }
+}
 
 /// Parameters of the replay (`[replay]` in the config file).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -85,7 +153,9 @@ pub enum ReplayError {
         t: f64,
     },
     /// Negative GPS times cannot be carried as the wire's unsigned ns.
-    #[error("point {index} has a negative GPS time {t} s; the wire carries GPS time as unsigned ns")]
+    #[error(
+        "point {index} has a negative GPS time {t} s; the wire carries GPS time as unsigned ns"
+    )]
     NegativeTime {
         /// Column index.
         index: usize,
@@ -195,7 +265,9 @@ pub fn encode_stream(
 ) -> Result<(), ReplayError> {
     let mut enc = StreamEncoder::new();
     let mut buf = vec![0u8; MAX_PACKET_LEN];
-    let n = enc.encode_config(words, &mut buf).map_err(ReplayError::Encode)?;
+    let n = enc
+        .encode_config(words, &mut buf)
+        .map_err(ReplayError::Encode)?;
     sink(&buf[..n])?;
     let mut cur = PoseCursor::new(traj);
     let mut recs: Vec<PointRecord> = Vec::with_capacity(MAX_POINTS_PER_PACKET);
@@ -205,7 +277,9 @@ pub fn encode_stream(
         let t_ns = ns_of(t, i)?;
         let (xp, zp) = project_point(&mut cur, cols.x[i], cols.y[i], cols.z[i], t)
             .ok_or(ReplayError::Uncovered { index: i, t })?;
-        let dt = t_ns.checked_sub(base_ns).and_then(|d| u32::try_from(d).ok());
+        let dt = t_ns
+            .checked_sub(base_ns)
+            .and_then(|d| u32::try_from(d).ok());
         let dt = match dt {
             Some(d) if !recs.is_empty() && recs.len() < MAX_POINTS_PER_PACKET => d,
             _ => {
@@ -256,7 +330,7 @@ fn run_chunk(
     line: &mut [u32],
 ) -> Result<ChunkOut, ReplayError> {
     let start = range.start;
-    let mut pipe: Box<HostPipeline> = Box::new(HostPipeline::new());
+    let mut pipe: Box<HostPipeline> = Box::default();
     let mut out = ChunkOut {
         lines: 0,
         candidates: Vec::new(),
@@ -343,16 +417,25 @@ pub fn run_kernel(
         }
     }
     let done = std::sync::atomic::AtomicU64::new(0);
-    let outs: Vec<Result<ChunkOut, ReplayError>> = parts
-        .into_par_iter()
-        .map(|(rg, r, s, l)| {
-            let len = rg.len() as u64;
-            let o = run_chunk(cols, rg, traj, words, &rule, r, s, l);
-            let d = done.fetch_add(len, std::sync::atomic::Ordering::Relaxed) + len;
-            progress(d);
-            o
-        })
-        .collect();
+    // A pool of our own: a pipeline holds a few MB of fixed buffers, more than rayon's
+    // default 2 MiB worker stacks take in a debug build.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(rayon::current_num_threads())
+        .stack_size(PIPELINE_STACK)
+        .build()
+        .map_err(|e| ReplayError::Io(std::io::Error::other(e)))?;
+    let outs: Vec<Result<ChunkOut, ReplayError>> = pool.install(|| {
+        parts
+            .into_par_iter()
+            .map(|(rg, r, s, l)| {
+                let len = rg.len() as u64;
+                let o = run_chunk(cols, rg, traj, words, &rule, r, s, l);
+                let d = done.fetch_add(len, std::sync::atomic::Ordering::Relaxed) + len;
+                progress(d);
+                o
+            })
+            .collect()
+    });
     let mut counters = ReplayCounters::default();
     let mut candidates = Vec::new();
     let mut bases = Vec::with_capacity(outs.len());
@@ -380,11 +463,17 @@ pub fn run_kernel(
         .zip(bases.par_iter())
         .for_each(|(sl, &b)| {
             if b > 0 {
-                sl.iter_mut().filter(|v| **v != u32::MAX).for_each(|v| *v += b);
+                sl.iter_mut()
+                    .filter(|v| **v != u32::MAX)
+                    .for_each(|v| *v += b);
             }
         });
-    let returned = status.iter().filter(|&&s| s != STATUS_NOT_PROCESSED).count() as u64;
-    counters.lost = counters.points_sent - returned - counters.truncated.min(counters.points_sent - returned);
+    let returned = status
+        .iter()
+        .filter(|&&s| s != STATUS_NOT_PROCESSED)
+        .count() as u64;
+    counters.lost =
+        counters.points_sent - returned - counters.truncated.min(counters.points_sent - returned);
     Ok(KernelResults {
         rho_deg: rho,
         status,

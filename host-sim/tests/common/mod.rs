@@ -99,7 +99,10 @@ impl Road {
         let mut b = Builder::from((1, 4));
         b.point_format = las::point::Format::new(6).unwrap();
         b.point_format.is_compressed = points.extension().is_some_and(|e| e == "laz");
-        let t = |offset: f64| las::Transform { scale: 0.0001, offset };
+        let t = |offset: f64| las::Transform {
+            scale: 0.0001,
+            offset,
+        };
         b.transforms = las::Vector {
             x: t(X0),
             y: t(Y0),
