@@ -123,4 +123,6 @@ pub fn extract_edges(input: &BendInput, params: &BendParams) -> Vec<EdgeLine> {
 }
 
 #[cfg(test)]
+mod devrun;
+#[cfg(test)]
 mod tests;
