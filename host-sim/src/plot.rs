@@ -173,21 +173,49 @@ fn above_local_ground(c: &Cloud, idx: &[usize]) -> Vec<f64> {
         .into_iter()
         .map(|(k, mut v)| (k, quantile(&mut v, 0.05)))
         .collect();
+    // Ground at each cell's centre: the lowest cell low within the neighbourhood.
     let mut ground: HashMap<(i64, i64), f64> = HashMap::new();
-    idx.iter()
-        .map(|&i| {
-            let k = key(i);
-            let g = *ground.entry(k).or_insert_with(|| {
-                let mut g = f64::INFINITY;
-                for dx in -GROUND_REACH..=GROUND_REACH {
-                    for dy in -GROUND_REACH..=GROUND_REACH {
-                        if let Some(&l) = low.get(&(k.0 + dx, k.1 + dy)) {
-                            g = g.min(l);
-                        }
+    let mut ground_at = |k: (i64, i64)| -> Option<f64> {
+        if !low.contains_key(&k) {
+            return None;
+        }
+        Some(*ground.entry(k).or_insert_with(|| {
+            let mut g = f64::INFINITY;
+            for dx in -GROUND_REACH..=GROUND_REACH {
+                for dy in -GROUND_REACH..=GROUND_REACH {
+                    if let Some(&l) = low.get(&(k.0 + dx, k.1 + dy)) {
+                        g = g.min(l);
                     }
                 }
-                g
-            });
+            }
+            g
+        }))
+    };
+    // Bilinear between the four surrounding cell centres (those with points), so that the
+    // ground has no steps at cell borders, which would show as squares on the road.
+    idx.iter()
+        .map(|&i| {
+            let fx = c.x[i] / GROUND_CELL_M - 0.5;
+            let fy = c.y[i] / GROUND_CELL_M - 0.5;
+            let (i0, j0) = (fx.floor() as i64, fy.floor() as i64);
+            let (tx, ty) = (fx - i0 as f64, fy - j0 as f64);
+            let (mut sum, mut wsum) = (0.0, 0.0);
+            for (di, dj, w) in [
+                (0, 0, (1.0 - tx) * (1.0 - ty)),
+                (1, 0, tx * (1.0 - ty)),
+                (0, 1, (1.0 - tx) * ty),
+                (1, 1, tx * ty),
+            ] {
+                if let Some(g) = ground_at((i0 + di, j0 + dj)) {
+                    sum += w * g;
+                    wsum += w;
+                }
+            }
+            let g = if wsum > 1e-12 {
+                sum / wsum
+            } else {
+                ground_at(key(i)).unwrap_or(c.z[i])
+            };
             c.z[i] - g
         })
         .collect()
