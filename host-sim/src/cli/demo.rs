@@ -10,9 +10,12 @@ use anyhow::Context;
 use clap::ValueEnum;
 use curbtrace_core::kernel::{Kernel, KernelParams, PointStatus};
 use curbtrace_core::scanline::Line;
+use curbtrace_host_sim::config::Config;
 use curbtrace_host_sim::eval::report::{write_demo_outputs, DemoInputs};
 use curbtrace_host_sim::model::{write_geojson, Crs, EdgeLine, Side};
+use curbtrace_host_sim::pipeline::{self, ExtractOptions, Method, Progress};
 use curbtrace_host_sim::plot::{Cloud, CrossSection, Window};
+use curbtrace_host_sim::qiu::{self, QiuInput, QiuParams};
 use curbtrace_host_sim::simulate::{self, scanner::Return, Simulation};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -66,20 +69,115 @@ struct Extracted {
     parameters: Vec<(String, String)>,
 }
 
-/// Extracts the edges from the simulated files in `out`.
-///
-/// INTEGRATION POINT: the extractor (`pipeline::replay_file` + `bend::extract_edges`, and
-/// `qiu` for `--method qiu`) is not part of this branch yet; the lead wires it here.
-fn extract(out: &Path, method: MethodArg) -> anyhow::Result<Extracted> {
-    anyhow::bail!(
-        "curbtrace demo: the scene is simulated into {} but this build has no {} extractor \
-         wired into the demo yet; run `curbtrace extract {}/points.laz --trajectory \
-         {}/trajectory.csv -o edges.geojson` and `curbtrace eval` instead",
-        out.display(),
-        method.as_str(),
-        out.display(),
-        out.display()
-    )
+/// Flattens a serialised parameter struct into (dotted name, value) rows for the report.
+fn parameter_rows(prefix: &str, v: &serde_json::Value, out: &mut Vec<(String, String)>) {
+    match v {
+        serde_json::Value::Object(m) => {
+            for (k, v) in m {
+                let name = if prefix.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{prefix}.{k}")
+                };
+                parameter_rows(&name, v, out);
+            }
+        }
+        other => out.push((prefix.to_string(), other.to_string())),
+    }
+}
+
+/// Extracts the edges from the simulated files in `out` with `method`, reading them back
+/// as `curbtrace extract` would (the same library calls).
+fn extract(out: &Path, method: MethodArg, cfg: &Config, tty: bool) -> anyhow::Result<Extracted> {
+    let points = out.join("points.laz");
+    let traj = out.join("trajectory.csv");
+    let progress = if tty {
+        Progress::bar()
+    } else {
+        Progress::hidden()
+    };
+    let mut parameters = Vec::new();
+    match method {
+        MethodArg::Bend => {
+            let opts = ExtractOptions {
+                scanner: None,
+                method: Method::Bend,
+            };
+            let r = pipeline::extract_file_with(&points, &traj, cfg, &opts, &progress)?;
+            let s = &r.summary;
+            parameter_rows("", &serde_json::to_value(cfg)?, &mut parameters);
+            Ok(Extracted {
+                timings: vec![
+                    ("extract: reading LAZ".into(), s.times.read_s),
+                    ("extract: trajectory".into(), s.times.trajectory_s),
+                    ("extract: projection + core".into(), s.times.core_s),
+                    (
+                        "extract: seeding, tracking, filters".into(),
+                        s.times.edges_s,
+                    ),
+                    ("extract: total".into(), s.times.total_s),
+                ],
+                facts: vec![
+                    ("points read".into(), s.points_read().to_string()),
+                    ("scanlines (core)".into(), s.core.scanlines.to_string()),
+                    ("seed candidates (core)".into(), s.candidates.to_string()),
+                    (
+                        "edges".into(),
+                        format!("{}, {:.1} m", s.edges, s.total_length_m),
+                    ),
+                    (
+                        "extraction speed".into(),
+                        format!(
+                            "{:.2} M points/s (this build)",
+                            s.points_read() as f64 / s.times.total_s.max(1e-9) / 1e6
+                        ),
+                    ),
+                ],
+                edges: r.edges,
+                parameters,
+            })
+        }
+        MethodArg::Qiu => {
+            let opts = ExtractOptions {
+                scanner: None,
+                method: Method::Qiu,
+            };
+            let t = Instant::now();
+            let (cols, _las, trajectory, _dropped, times) =
+                pipeline::load(&points, &traj, &opts, &progress)?;
+            let params = QiuParams::default();
+            let t_edges = Instant::now();
+            let input = QiuInput {
+                x: &cols.x,
+                y: &cols.y,
+                z: &cols.z,
+                t: &cols.t,
+                trajectory: &trajectory,
+            };
+            let mut edges = qiu::extract_edges(&input, &params);
+            for e in &mut edges {
+                e.method.get_or_insert_with(|| "qiu".to_string());
+            }
+            let edges_s = t_edges.elapsed().as_secs_f64();
+            progress.finish();
+            parameter_rows("qiu", &serde_json::to_value(&params)?, &mut parameters);
+            let len: f64 = edges.iter().map(|e| e.length_m()).sum();
+            Ok(Extracted {
+                timings: vec![
+                    ("extract: reading LAZ".into(), times.read_s),
+                    ("extract: trajectory".into(), times.trajectory_s),
+                    ("extract: Qiu et al. method".into(), edges_s),
+                    ("extract: total".into(), t.elapsed().as_secs_f64()),
+                ],
+                facts: vec![
+                    ("points read".into(), cols.x.len().to_string()),
+                    ("edges".into(), format!("{}, {len:.1} m", edges.len())),
+                ],
+                edges,
+                parameters,
+            })
+        }
+    }
 }
 
 /// Runs `curbtrace demo`.
@@ -110,11 +208,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
 
     // 2. Extract.
-    let ex = extract(out, args.method)?;
+    let cfg = Config::default();
+    let ex = extract(out, args.method, &cfg, tty)?;
     write_geojson(&out.join("edges.geojson"), &ex.edges, Some(&crs))?;
 
     // 3. One scanline through the core, for the cross-section picture.
-    let profile = scanline_profile(&sim, &KernelParams::DEFAULT);
+    let profile = scanline_profile(&sim, &cfg.kernel.to_params());
 
     // 4. Evaluate, draw, report.
     let x: Vec<f64> = sim.returns.iter().map(|r| r.p[0] + origin[0]).collect();
