@@ -44,7 +44,7 @@ impl MethodArg {
 #[derive(clap::Args)]
 pub struct Args {
     /// Directory for the simulated scene, the edges, the report and the pictures.
-    #[arg(long, default_value = "curbtrace-demo", value_name = "DIR")]
+    #[arg(long, default_value = "demo-out", value_name = "DIR")]
     pub out: PathBuf,
     /// Extraction method.
     #[arg(long, value_enum, default_value_t = MethodArg::Bend)]
@@ -81,6 +81,17 @@ fn parameter_rows(prefix: &str, v: &serde_json::Value, out: &mut Vec<(String, St
                 };
                 parameter_rows(&name, v, out);
             }
+        }
+        // Parameters are f32 in the core: print the shortest decimal that round-trips
+        // through f32 (0.07, not 0.07000000029802322).
+        serde_json::Value::Number(n) if n.is_f64() => {
+            let v = n.as_f64().unwrap_or(f64::NAN);
+            let short = if (v as f32) as f64 == v {
+                format!("{}", v as f32)
+            } else {
+                format!("{v}")
+            };
+            out.push((prefix.to_string(), short))
         }
         other => out.push((prefix.to_string(), other.to_string())),
     }
