@@ -173,21 +173,49 @@ fn above_local_ground(c: &Cloud, idx: &[usize]) -> Vec<f64> {
         .into_iter()
         .map(|(k, mut v)| (k, quantile(&mut v, 0.05)))
         .collect();
+    // Ground at each cell's centre: the lowest cell low within the neighbourhood.
     let mut ground: HashMap<(i64, i64), f64> = HashMap::new();
-    idx.iter()
-        .map(|&i| {
-            let k = key(i);
-            let g = *ground.entry(k).or_insert_with(|| {
-                let mut g = f64::INFINITY;
-                for dx in -GROUND_REACH..=GROUND_REACH {
-                    for dy in -GROUND_REACH..=GROUND_REACH {
-                        if let Some(&l) = low.get(&(k.0 + dx, k.1 + dy)) {
-                            g = g.min(l);
-                        }
+    let mut ground_at = |k: (i64, i64)| -> Option<f64> {
+        if !low.contains_key(&k) {
+            return None;
+        }
+        Some(*ground.entry(k).or_insert_with(|| {
+            let mut g = f64::INFINITY;
+            for dx in -GROUND_REACH..=GROUND_REACH {
+                for dy in -GROUND_REACH..=GROUND_REACH {
+                    if let Some(&l) = low.get(&(k.0 + dx, k.1 + dy)) {
+                        g = g.min(l);
                     }
                 }
-                g
-            });
+            }
+            g
+        }))
+    };
+    // Bilinear between the four surrounding cell centres (those with points), so that the
+    // ground has no steps at cell borders, which would show as squares on the road.
+    idx.iter()
+        .map(|&i| {
+            let fx = c.x[i] / GROUND_CELL_M - 0.5;
+            let fy = c.y[i] / GROUND_CELL_M - 0.5;
+            let (i0, j0) = (fx.floor() as i64, fy.floor() as i64);
+            let (tx, ty) = (fx - i0 as f64, fy - j0 as f64);
+            let (mut sum, mut wsum) = (0.0, 0.0);
+            for (di, dj, w) in [
+                (0, 0, (1.0 - tx) * (1.0 - ty)),
+                (1, 0, tx * (1.0 - ty)),
+                (0, 1, (1.0 - tx) * ty),
+                (1, 1, tx * ty),
+            ] {
+                if let Some(g) = ground_at((i0 + di, j0 + dj)) {
+                    sum += w * g;
+                    wsum += w;
+                }
+            }
+            let g = if wsum > 1e-12 {
+                sum / wsum
+            } else {
+                ground_at(key(i)).unwrap_or(c.z[i])
+            };
             c.z[i] - g
         })
         .collect()
@@ -893,7 +921,15 @@ pub struct CrossSection<'a> {
     pub tau_deg: Option<(f64, f64)>,
     /// Horizontal range to show, metres; `None`: all points.
     pub x_range_m: Option<(f64, f64)>,
+    /// Vertical range of the profile, metres; `None`: all points in the x′ range. Walls
+    /// and poles reach metres above the road, so a picture of the curb wants about
+    /// 1 m from the road down.
+    pub z_range_m: Option<(f64, f64)>,
 }
+
+/// The smoothed profile is drawn as a line broken where consecutive points are farther
+/// apart than this, metres (the sky between the two sides, occlusion shadows).
+const PROFILE_BREAK_M: f64 = 0.5;
 
 /// Draws a scanline cross-section: top panel x′–z′ (raw points grey, smoothed line blue,
 /// candidates red), bottom panel ρ per point against x′ before (grey) and after (blue)
@@ -934,15 +970,22 @@ pub fn cross_section_png(path: &Path, cs: &CrossSection) -> Result<(), PlotError
         return Err(input_err(path, "no finite x′ range to draw"));
     }
     let in_x = |x: f64| x >= xa && x <= xb;
-    let (mut za, mut zb) = finite_range(
-        &mut (0..n)
-            .filter(|&i| in_x(cs.raw_x_m[i]))
-            .flat_map(|i| [cs.raw_z_m[i], cs.smooth_z_m[i]]),
-    );
-    if !(za.is_finite() && zb.is_finite()) {
-        (za, zb) = (-1.0, 0.0);
-    }
-    let zpad = ((zb - za) * 0.08).max(0.02);
+    let (za, zb, zpad) = match cs.z_range_m {
+        Some((a, b)) if a.is_finite() && b.is_finite() && b > a => (a, b, 0.0),
+        _ => {
+            let (mut za, mut zb) = finite_range(
+                &mut (0..n)
+                    .filter(|&i| in_x(cs.raw_x_m[i]))
+                    .flat_map(|i| [cs.raw_z_m[i], cs.smooth_z_m[i]]),
+            );
+            if !(za.is_finite() && zb.is_finite()) {
+                (za, zb) = (-1.0, 0.0);
+            }
+            (za, zb, ((zb - za) * 0.08).max(0.02))
+        }
+    };
+    let (z_lo, z_hi) = (za - zpad, zb + zpad);
+    let in_xz = |x: f64, z: f64| in_x(x) && z >= z_lo && z <= z_hi;
     let (rmin, rmax) = finite_range(
         &mut (0..n)
             .filter(|&i| in_x(cs.raw_x_m[i]))
@@ -975,7 +1018,7 @@ pub fn cross_section_png(path: &Path, cs: &CrossSection) -> Result<(), PlotError
         .margin(12)
         .x_label_area_size(50)
         .y_label_area_size(80)
-        .build_cartesian_2d(xa..xb, (za - zpad)..(zb + zpad))
+        .build_cartesian_2d(xa..xb, z_lo..z_hi)
         .map_err(&err)?;
     ch.configure_mesh()
         .x_desc("x′ [m]  (left of the vehicle positive)")
@@ -989,19 +1032,38 @@ pub fn cross_section_png(path: &Path, cs: &CrossSection) -> Result<(), PlotError
         .draw()
         .map_err(&err)?;
     // The smoothed line first and the raw points on top, so that both stay visible.
-    let smooth: Vec<(f64, f64)> = (0..n)
-        .filter(|&i| {
-            cs.smooth_x_m[i].is_finite() && cs.smooth_z_m[i].is_finite() && in_x(cs.smooth_x_m[i])
-        })
-        .map(|i| (cs.smooth_x_m[i], cs.smooth_z_m[i]))
-        .collect();
-    ch.draw_series(LineSeries::new(smooth, blue.stroke_width(2)))
-        .map_err(&err)?
-        .label("after Taubin smoothing")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], blue.stroke_width(2)));
+    let mut pieces: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+    for i in 0..n {
+        let p = (cs.smooth_x_m[i], cs.smooth_z_m[i]);
+        if !(p.0.is_finite() && p.1.is_finite()) {
+            continue;
+        }
+        if let Some(cur) = pieces.last_mut() {
+            if cur
+                .last()
+                .is_some_and(|q| (p.0 - q.0).hypot(p.1 - q.1) > PROFILE_BREAK_M)
+            {
+                pieces.push(Vec::new());
+            }
+        }
+        if let Some(cur) = pieces.last_mut() {
+            cur.push(p);
+        }
+    }
+    let rect = (xa, xb, z_lo, z_hi);
+    let smooth_style = blue.stroke_width(2);
+    ch.draw_series(
+        pieces
+            .iter()
+            .flat_map(|p| clip_polyline(p, rect))
+            .map(|p| PathElement::new(p, smooth_style)),
+    )
+    .map_err(&err)?
+    .label("after Taubin smoothing")
+    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], blue.stroke_width(2)));
     ch.draw_series(
         (0..n)
-            .filter(|&i| in_x(cs.raw_x_m[i]) && cs.raw_z_m[i].is_finite())
+            .filter(|&i| in_xz(cs.raw_x_m[i], cs.raw_z_m[i]))
             .map(|i| Circle::new((cs.raw_x_m[i], cs.raw_z_m[i]), 2, grey.mix(0.75).filled())),
     )
     .map_err(&err)?
@@ -1009,9 +1071,12 @@ pub fn cross_section_png(path: &Path, cs: &CrossSection) -> Result<(), PlotError
     .legend(move |(x, y)| Circle::new((x + 10, y), 3, grey.filled()));
     if !cs.candidates.is_empty() {
         ch.draw_series(
-            cs.candidates.iter().map(|&i| {
-                Circle::new((cs.smooth_x_m[i], cs.smooth_z_m[i]), 7, red.stroke_width(3))
-            }),
+            cs.candidates
+                .iter()
+                .filter(|&&i| in_xz(cs.smooth_x_m[i], cs.smooth_z_m[i]))
+                .map(|&i| {
+                    Circle::new((cs.smooth_x_m[i], cs.smooth_z_m[i]), 7, red.stroke_width(3))
+                }),
         )
         .map_err(&err)?
         .label("seed candidate")
@@ -1093,7 +1158,7 @@ pub fn cross_section_png(path: &Path, cs: &CrossSection) -> Result<(), PlotError
     if !cs.candidates.is_empty() {
         ch.draw_series(cs.candidates.iter().filter_map(|&i| {
             let (x, r) = (cs.smooth_x_m[i], cs.smooth_rho_deg[i]);
-            (x.is_finite() && r.is_finite()).then(|| Circle::new((x, r), 7, red.stroke_width(3)))
+            (in_x(x) && r.is_finite()).then(|| Circle::new((x, r), 7, red.stroke_width(3)))
         }))
         .map_err(&err)?
         .label("seed candidate")
@@ -1402,6 +1467,7 @@ mod tests {
             candidates: &cand,
             tau_deg: Some((30.0, 150.0)),
             x_range_m: None,
+            z_range_m: None,
         };
         let (_keep, dir) = out_dir();
         let p = dir.join("cs.png");

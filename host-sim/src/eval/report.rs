@@ -263,6 +263,15 @@ pub fn write_demo_outputs(out_dir: &Path, inp: &DemoInputs) -> Result<DemoOutput
             .into_iter()
             .map(|(n, w)| (n.clone(), caption_of(&n).to_string(), w))
             .collect();
+    // A parked car the caller knows of shows the same as the occlusion found from the
+    // reference; keep one.
+    if inp
+        .extra_windows
+        .iter()
+        .any(|w| w.0.starts_with("parked_car"))
+    {
+        windows.retain(|w| w.0 != "occlusion");
+    }
     windows.extend(inp.extra_windows.iter().cloned());
     for (name, caption, w) in windows {
         let file = format!("zoom_{name}.png");
