@@ -25,6 +25,9 @@ die() { log "$*"; exit 1; }
 [ $# -eq 1 ] || die "usage: firmware/check.sh STREAM.bin"
 [ -f "$1" ] || die "$1: no such file"
 STREAM=$(realpath "$1")
+# Host cargo commands run from the root: inside firmware/, firmware/.cargo/config.toml would
+# make them build for the Cortex-M4F.
+cd "$ROOT"
 case "$STREAM" in *[[:space:],]*) die "$STREAM: the path must not contain spaces or commas (QEMU's -semihosting-config splits on them)";; esac
 FW_TARGET=${FIRMWARE_TARGET_DIR:-$FW/target}
 HOST_TARGET=${CARGO_TARGET_DIR:-$ROOT/target}

@@ -1,0 +1,236 @@
+//! The processing loop, the same on the board and in host tests: bytes from a byte link
+//! into the core's ring the way a DMA channel fills it, the kernel on every completed
+//! scanline, each line's output packets out through another byte link.
+//!
+//! The links are `embedded_io::{Read, Write}` (embedded-hal 1.0 has no serial traits), so
+//! a UART, SPI or DMA driver replaces the semihosting files of the QEMU build without this
+//! loop changing.
+
+use curbtrace_core::kernel::{Kernel, KernelCounters, KernelParams, ScanlineOutput};
+use curbtrace_core::scanline::{Ingest, IngestCounters, IngestEvent};
+use curbtrace_core::wire::{
+    EncodeError, OutputHeaderRepr, OutputPointRepr, StreamEncoder, MAX_OUTPUT_POINTS_PER_PACKET,
+    MAX_PACKET_LEN, MAX_POINTS_PER_PACKET, POINTS_PREFIX_LEN, POINT_RECORD_LEN,
+};
+use core::mem::MaybeUninit;
+use core::ptr::addr_of_mut;
+
+use embedded_io::{Read, Write};
+
+/// Largest line the firmware holds: a VQ-250-class line is 2000 pulses.
+pub const MAX_POINTS: usize = 2048;
+
+/// Bytes of one points packet with [`MAX_POINTS_PER_PACKET`] points.
+const FULL_POINTS_PACKET: usize = curbtrace_core::wire::HEADER_LEN
+    + POINTS_PREFIX_LEN
+    + MAX_POINTS_PER_PACKET * POINT_RECORD_LEN
+    + curbtrace_core::wire::CRC_LEN;
+
+/// The ring: one full line of [`MAX_POINTS`] points in packets (the next line keeps
+/// arriving while the kernel works on the last one), plus one packet that may sit in the
+/// ring half-parsed when the line is handed over. 32 × 1304 + 1472 = 43 200 bytes.
+pub const RING: usize =
+    MAX_POINTS.div_ceil(MAX_POINTS_PER_PACKET) * FULL_POINTS_PACKET + MAX_PACKET_LEN;
+
+/// Bytes moved per transfer into the ring (a DMA half-transfer, a `read()` call).
+pub const DMA_CHUNK: usize = 1024;
+
+/// Ingest and kernel: all the working memory of the core, for lines of up to `N` points.
+pub struct Node<const RING: usize, const N: usize> {
+    /// Ring, packet parser, scanline assembly.
+    pub ingest: Ingest<RING, N>,
+    /// The per-scanline kernel.
+    pub kernel: Kernel<N>,
+}
+
+impl<const RING: usize, const N: usize> Node<RING, N> {
+    /// An empty node running the default parameters until the stream's config packet.
+    pub fn new() -> Self {
+        Self {
+            ingest: Ingest::new(),
+            kernel: Kernel::new(KernelParams::DEFAULT),
+        }
+    }
+}
+
+impl<const RING: usize, const N: usize> Node<RING, N> {
+    /// Constructs a node in place at `slot` (the node is ~80 KiB: built by value it would
+    /// pass through the stack, which the firmware keeps small).
+    pub fn init(slot: &mut MaybeUninit<Self>) -> &mut Self {
+        let p = slot.as_mut_ptr();
+        // SAFETY: `p` points to writable, properly aligned memory for a `Self`; both fields
+        // are written before the reference is created, so the node is fully initialised.
+        unsafe {
+            addr_of_mut!((*p).ingest).write(Ingest::new());
+            addr_of_mut!((*p).kernel).write(Kernel::new(KernelParams::DEFAULT));
+            &mut *p
+        }
+    }
+}
+
+impl<const RING: usize, const N: usize> Default for Node<RING, N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// What a run did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Summary {
+    /// The ingest's counters at the end.
+    pub ingest: IngestCounters,
+    /// Kernel counters summed over all lines.
+    pub kernel: KernelCounters,
+    /// Lines processed.
+    pub lines: u32,
+    /// Config packets applied.
+    pub configs: u32,
+    /// Config packets whose parameters were rejected (the previous ones stayed).
+    pub configs_rejected: u32,
+    /// Output packets written.
+    pub packets_out: u32,
+    /// Output bytes written.
+    pub bytes_out: u64,
+}
+
+/// Why a run stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Error<R, W> {
+    /// The input link failed.
+    Read(R),
+    /// The output link failed.
+    Write(W),
+    /// A line's output could not be encoded (line index, encoder error).
+    Encode(u32, EncodeError),
+    /// The ring had no free space although every complete packet had been taken out
+    /// (cannot happen with `RING` ≥ `MAX_PACKET_LEN`; reported rather than looping).
+    RingStuck,
+}
+
+/// Runs the whole input stream through `node`, writing every line's output packets to
+/// `output`; `packet` is the one output packet buffer.
+pub fn run<R: Read, W: Write, const RING: usize, const N: usize>(
+    node: &mut Node<RING, N>,
+    input: &mut R,
+    output: &mut W,
+    packet: &mut [u8; MAX_PACKET_LEN],
+) -> Result<Summary, Error<R::Error, W::Error>> {
+    let mut sum = Summary::default();
+    let mut enc = StreamEncoder::new();
+    loop {
+        // Fill the ring's free space in place, as a DMA channel would (no copy).
+        let (free, _) = node.ingest.free_slices_mut();
+        let want = free.len().min(DMA_CHUNK);
+        if want == 0 {
+            return Err(Error::RingStuck);
+        }
+        let n = input.read(&mut free[..want]).map_err(Error::Read)?;
+        if n == 0 {
+            break;
+        }
+        node.ingest.commit(n);
+        drain(node, &mut enc, output, packet, &mut sum)?;
+    }
+    node.ingest.finish();
+    drain(node, &mut enc, output, packet, &mut sum)?;
+    output.flush().map_err(Error::Write)?;
+    sum.ingest = node.ingest.counters();
+    Ok(sum)
+}
+
+/// Processes every event the ring holds.
+fn drain<W: Write, E, const RING: usize, const N: usize>(
+    node: &mut Node<RING, N>,
+    enc: &mut StreamEncoder,
+    output: &mut W,
+    packet: &mut [u8; MAX_PACKET_LEN],
+    sum: &mut Summary,
+) -> Result<(), Error<E, W::Error>> {
+    while let Some(event) = node.ingest.poll() {
+        match event {
+            IngestEvent::Config(words) => {
+                match KernelParams::from_words(&words).and_then(|p| node.kernel.set_params(p)) {
+                    Ok(()) => sum.configs += 1,
+                    Err(_) => sum.configs_rejected += 1,
+                }
+            }
+            IngestEvent::Line(line) => {
+                let out = node.kernel.process(line);
+                add_counters(&mut sum.kernel, &out.counters);
+                sum.lines += 1;
+                emit_line(&out, enc, packet, output, sum)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+fn add_counters(total: &mut KernelCounters, c: &KernelCounters) {
+    total.points_in += c.points_in;
+    total.kept += c.kept;
+    total.irregular += c.irregular;
+    total.no_neighbour += c.no_neighbour;
+    total.non_finite += c.non_finite;
+    total.peaks += c.peaks;
+    total.capped_windows += c.capped_windows;
+    total.smooth_pieces += c.smooth_pieces;
+}
+
+/// The wire header of a line's output.
+pub fn output_header(out: &ScanlineOutput<'_>) -> Result<OutputHeaderRepr, EncodeError> {
+    let n = out.tag.len();
+    let u16_of = |v: u32| u16::try_from(v).map_err(|_| EncodeError::OutOfRange { index: n });
+    Ok(OutputHeaderRepr {
+        index: out.index,
+        start_time_ns: out.start_time_ns,
+        params_hash: out.params_hash,
+        truncated: out.truncated,
+        line_len: u16::try_from(n).map_err(|_| EncodeError::OutOfRange { index: n })?,
+        first: 0,
+        nadir: out.nadir,
+        left: out.left,
+        right: out.right,
+        kept: u16_of(out.counters.kept)?,
+        irregular: u16_of(out.counters.irregular)?,
+        no_neighbour: u16_of(out.counters.no_neighbour)?,
+        peaks: u16_of(out.counters.peaks)?,
+    })
+}
+
+/// Writes one line's output packets, one packet buffer at a time (a whole 2048-point line
+/// would need 34 KiB at once).
+fn emit_line<W: Write, E>(
+    out: &ScanlineOutput<'_>,
+    enc: &mut StreamEncoder,
+    packet: &mut [u8; MAX_PACKET_LEN],
+    output: &mut W,
+    sum: &mut Summary,
+) -> Result<(), Error<E, W::Error>> {
+    let header = output_header(out).map_err(|e| Error::Encode(out.index, e))?;
+    let point = |i: usize| {
+        let get = || -> Option<OutputPointRepr> {
+            let status = *out.status.get(i)? as u8;
+            OutputPointRepr::from_f32(
+                *out.tag.get(i)?,
+                *out.x_m.get(i)?,
+                *out.z_m.get(i)?,
+                *out.rho_deg.get(i)?,
+                status,
+                i,
+            )
+            .ok()
+        };
+        get().ok_or(EncodeError::OutOfRange { index: i })
+    };
+    for k in 0..header.fragments() {
+        let first = u16::try_from(k * MAX_OUTPUT_POINTS_PER_PACKET)
+            .map_err(|_| Error::Encode(out.index, EncodeError::OutOfRange { index: k }))?;
+        let n = enc
+            .encode_output_fragment(&header, first, point, packet)
+            .map_err(|e| Error::Encode(out.index, e))?;
+        output.write_all(&packet[..n]).map_err(Error::Write)?;
+        sum.packets_out += 1;
+        sum.bytes_out += n as u64;
+    }
+    Ok(())
+}
