@@ -234,3 +234,121 @@ fn emit_line<W: Write, E>(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use curbtrace_core::wire::{OutputHeaderRepr, Packet, PointRecord, CONFIG_WORDS};
+
+    /// A reader that hands out at most `step` bytes per call (a slow link).
+    struct Trickle<'a> {
+        data: &'a [u8],
+        step: usize,
+    }
+    impl embedded_io::ErrorType for Trickle<'_> {
+        type Error = core::convert::Infallible;
+    }
+    impl Read for Trickle<'_> {
+        fn read(&mut self, buf: &mut [u8]) -> Result<usize, Self::Error> {
+            let n = self.step.min(buf.len()).min(self.data.len());
+            buf[..n].copy_from_slice(&self.data[..n]);
+            self.data = &self.data[n..];
+            Ok(n)
+        }
+    }
+    struct Sink(Vec<u8>);
+    impl embedded_io::ErrorType for Sink {
+        type Error = core::convert::Infallible;
+    }
+    impl Write for Sink {
+        fn write(&mut self, buf: &[u8]) -> Result<usize, Self::Error> {
+            self.0.extend_from_slice(buf);
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> Result<(), Self::Error> {
+            Ok(())
+        }
+    }
+
+    /// A config packet, then `lines` lines of `n` points on a V-shaped profile (a bend at
+    /// the nadir), each line starting with the line-start flag.
+    fn stream(config: &[u32; CONFIG_WORDS], lines: usize, n: usize) -> Vec<u8> {
+        let mut enc = StreamEncoder::new();
+        let mut out = Vec::new();
+        let mut buf = [0u8; MAX_PACKET_LEN];
+        let k = enc.encode_config(config, &mut buf).unwrap();
+        out.extend_from_slice(&buf[..k]);
+        let mut tag = 0;
+        for l in 0..lines {
+            let pts: Vec<PointRecord> = (0..n)
+                .map(|i| {
+                    let x = -2.0 + 4.0 * i as f32 / n as f32;
+                    tag += 1;
+                    PointRecord {
+                        dt_ns: i as u32 * 1000,
+                        x_m: x,
+                        z_m: -2.0 + 0.1 * x.abs(),
+                        intensity: 0,
+                        line_start: i == 0,
+                        tag,
+                    }
+                })
+                .collect();
+            for (c, chunk) in pts.chunks(MAX_POINTS_PER_PACKET).enumerate() {
+                let base = 1_000_000_000 * (l as u64 + 1) + (c * MAX_POINTS_PER_PACKET) as u64 * 1000;
+                let k = enc.encode_points(base, chunk, &mut buf).unwrap();
+                out.extend_from_slice(&buf[..k]);
+            }
+        }
+        out
+    }
+
+    fn run_all(input: &[u8], step: usize) -> (Summary, Vec<u8>) {
+        let mut node: Box<Node<RING, 512>> = Box::default();
+        let mut packet = [0u8; MAX_PACKET_LEN];
+        let mut out = Sink(Vec::new());
+        let sum = run(&mut node, &mut Trickle { data: input, step }, &mut out, &mut packet)
+            .expect("runs");
+        (sum, out.0)
+    }
+
+    #[test]
+    fn chunking_does_not_change_the_output() {
+        let input = stream(&KernelParams::DEFAULT.to_words(), 3, 300);
+        let (sum, whole) = run_all(&input, usize::MAX);
+        assert_eq!(sum.lines, 3);
+        assert_eq!(sum.configs, 1);
+        assert_eq!(sum.ingest.points_in, 900);
+        assert_eq!(sum.ingest.bytes_dropped_full, 0);
+        // 300 points = 4 output packets of ≤ 88 points ((1472 − 56) / 16) per line.
+        assert_eq!(MAX_OUTPUT_POINTS_PER_PACKET, 88);
+        assert_eq!(sum.packets_out, 12);
+        assert_eq!(sum.bytes_out, whole.len() as u64);
+        for step in [1, 7, 1000] {
+            let (s, out) = run_all(&input, step);
+            assert_eq!(out, whole, "step {step}");
+            assert_eq!(s.lines, 3);
+        }
+        // Every packet is a valid output packet of a line with the nadir at its V.
+        let mut at = 0;
+        while at < whole.len() {
+            let p = Packet::new_checked(&whole[at..]).unwrap();
+            let len = p.length();
+            let p = Packet::new_unchecked(&whole[at..at + len]);
+            let (h, _) = OutputHeaderRepr::parse(&p).unwrap();
+            assert_eq!(h.line_len, 300);
+            assert!(h.nadir.is_some_and(|i| (145..=155).contains(&i)), "{:?}", h.nadir);
+            at += len;
+        }
+    }
+
+    #[test]
+    fn a_bad_config_is_counted_and_the_defaults_stay() {
+        let mut words = KernelParams::DEFAULT.to_words();
+        words[0] = f32::NAN.to_bits(); // d_b
+        let (sum, _) = run_all(&stream(&words, 1, 100), 64);
+        assert_eq!(sum.configs, 0);
+        assert_eq!(sum.configs_rejected, 1);
+        assert_eq!(sum.lines, 1);
+    }
+}
