@@ -112,7 +112,6 @@ sizes() { # ELF → "flash static_ram stack"
     END { printf "%d %d %d\n", flash, ram, stack }'
 }
 per_point() { awk -v n="$1" -v p="$2" 'BEGIN { if (p > 0) printf "%.1f\n", n / p; else print "n/a" }'; }
-stage() { awk -v s="$1" '$1 == "stage" && $2 == s { print $3; f = 1 } END { if (!f) print 0 }' "$2"; }
 total() { sed -n 's/^insns_total=\([0-9]*\).*/\1/p' "$1"; }
 
 read -r flash ram stack < <(sizes "$WORK/fw-libm.elf")
@@ -126,12 +125,23 @@ echo "static_ram_bytes: $ram"
 echo "stack_reserved_bytes: $stack"
 echo "ram_total_bytes: $((ram + stack)) (of 131072)"
 echo "stack_high_water_bytes: $(fig stack_high_water_bytes "$WORK/fw-libm.txt")"
+stage() { awk -v s="$1" '$1 == "stage" && $2 == s { n = $3 } END { print n + 0 }' "$2"; }
 for name in libm micromath; do
   c="$WORK/counts-$name.log"
-  echo "insns_per_point_$name: $(per_point "$(total "$c")" "$points")"
-  for s in ingest assembly bend smoothing peaks output other; do
-    echo "insns_per_point_${name}_$s: $(per_point "$(stage "$s" "$c")" "$points")"
+  t=$(total "$c")
+  echo "insns_per_point_$name: $(per_point "$t" "$points")"
+  echo "insns_per_point_${name}_ingest: $(per_point $(($(stage ingest "$c") + $(stage ingest+crc "$c"))) "$points")"
+  echo "insns_per_point_${name}_ingest_crc_part: $(per_point "$(stage ingest+crc "$c")" "$points")"
+  for s in assembly bend smoothing peaks; do
+    echo "insns_per_point_${name}_$s: $(per_point "$(stage $s "$c")" "$points")"
   done
+  echo "insns_per_point_${name}_kernel_partition: $(per_point "$(stage kernel "$c")" "$points")"
+  echo "insns_per_point_${name}_output: $(per_point $(($(stage output "$c") + $(stage output+crc "$c"))) "$points")"
+  echo "insns_per_point_${name}_output_crc_part: $(per_point "$(stage output+crc "$c")" "$points")"
+  echo "insns_per_point_${name}_other: $(per_point "$(stage other "$c")" "$points")"
+  # Real time on the STM32F405 at 168 MHz, assuming 1.5 cycles per instruction
+  # (docs/benchmarks.md, "Firmware", says why).
+  awk -v t="$t" -v p="$points" -v n="$name" 'BEGIN { if (t > 0) printf "points_per_s_168mhz_cpi1.5_%s: %d\n", n, 168e6 / (1.5 * t / p) }'
 done
 echo "flash_bytes_micromath: $flash_mm"
 echo "static_ram_bytes_micromath: $ram_mm"
