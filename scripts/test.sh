@@ -30,6 +30,9 @@ cargo clippy --workspace --all-targets -- -D warnings
 step "cargo test (workspace, release: the end-to-end tests run real scenes)"
 cargo test --workspace --release
 
+step "cargo test curbtrace-core with micromath (its rho against libm's, differential test)"
+cargo test -p curbtrace-core --release --features micromath
+
 # --- no_std core for the Cortex-M4F -----------------------------------------------------
 for feat in libm micromath; do
   step "curbtrace-core for thumbv7em-none-eabihf (Debian toolchain, feature $feat)"

@@ -12,6 +12,8 @@
 //!   parsed point packets into one [`scanline::Line`] at a time.
 //! - [`kernel`] — per scanline: bend angle ρ (§2.3), removal of irregular points (§2.4), Taubin
 //!   smoothing (§2.5), ρ again, peaks and the first peak each side of the nadir (§2.6).
+//! - [`pipeline`] — ingest and kernel together, bytes in, results out, and the encoding of
+//!   a line's result as output packets.
 //!
 //! Every buffer is bounded by a const generic; every byte and every point that enters is
 //! accounted for in counters.
@@ -21,5 +23,8 @@
 
 pub mod kernel;
 pub(crate) mod math;
+pub mod pipeline;
 pub mod scanline;
 pub mod wire;
+
+pub use pipeline::{encode_output, Pipeline, PipelineCounters};

@@ -54,33 +54,61 @@ fn beyond(x: &[f32], z: &[f32], a: usize, b: usize, d2: f32) -> bool {
     !(dist2(x, z, a, b) <= d2)
 }
 
-/// Backward sweep: stores t(i) − i in `t_off[i]` for every point; returns how many windows
-/// stopped at [`MAX_SIDE`] with the next point still within d_b.
-pub(crate) fn right_windows(x: &[f32], z: &[f32], d2: f32, t_off: &mut [u8]) -> u32 {
+/// Both neighbour windows of every point: i − s(i) into `s_off[i]`, t(i) − i into
+/// `t_off[i]`. Returns how many windows stopped at [`MAX_SIDE`] with the next point still
+/// within d_b (either side).
+///
+/// Each sweep is a serial chain (the next position depends on the last comparison: load,
+/// subtract, square, add, compare ≈ 20 cycles per step); running the forward and the
+/// backward sweep in the same loop gives the CPU two independent chains to overlap.
+pub(crate) fn windows(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8], t_off: &mut [u8]) -> u32 {
     let n = x.len();
-    let (z, t_off) = (&z[..n], &mut t_off[..n]);
+    let (z, s_off, t_off) = (&z[..n], &mut s_off[..n], &mut t_off[..n]);
     let mut capped = 0u32;
+    let mut s = 0usize;
     let mut t = n.saturating_sub(1);
-    for i in (0..n).rev() {
-        let hi = i + MAX_SIDE;
+    for k in 0..n {
+        // Forward: s(i) for i = k.
+        let i = k;
+        s = left_neighbour(x, z, d2, s, i);
+        s_off[i] = (i - s) as u8;
+        if s + MAX_SIDE == i && s > 0 && !beyond(x, z, s - 1, i, d2) {
+            capped += 1;
+        }
+        // Backward: t(j) for j = n − 1 − k.
+        let j = n - 1 - k;
+        let hi = j + MAX_SIDE;
         if t > hi {
             t = hi;
-            if !beyond(x, z, t + 1, i, d2) {
+            if !beyond(x, z, t + 1, j, d2) {
                 capped += 1;
             }
         }
-        while t > i && beyond(x, z, t, i, d2) {
+        // As in `left_neighbour`: up to two steps without a branch.
+        let t1 = t.saturating_sub(1).max(j);
+        let b0 = (t > j) & beyond(x, z, t, j, d2);
+        let b1 = b0 & (t1 > j) & beyond(x, z, t1, j, d2);
+        t -= usize::from(b0) + usize::from(b1);
+        while t > j && beyond(x, z, t, j, d2) {
             t -= 1;
         }
-        t_off[i] = (t - i) as u8;
+        t_off[j] = (t - j) as u8;
     }
     capped
 }
 
 /// The forward sweep's left neighbour of `i`, given the previous one.
 #[inline(always)]
-pub(crate) fn left_neighbour(x: &[f32], z: &[f32], d2: f32, s_prev: usize, i: usize) -> usize {
+fn left_neighbour(x: &[f32], z: &[f32], d2: f32, s_prev: usize, i: usize) -> usize {
     let mut s = s_prev.max(i.saturating_sub(MAX_SIDE));
+    // On a steady but noisy line s moves by 0 to 3 per point, at random: a loop would
+    // mispredict its exit nearly every time, and each test waits for the last one (load,
+    // subtract, square, add, compare). So test the next four positions at once, without a
+    // branch, and move past the leading ones beyond d_b; loop only for longer moves.
+    let s1 = (s + 1).min(i);
+    let b0 = (s < i) & beyond(x, z, s, i, d2);
+    let b1 = b0 & (s1 < i) & beyond(x, z, s1, i, d2);
+    s += usize::from(b0) + usize::from(b1);
     while s < i && beyond(x, z, s, i, d2) {
         s += 1;
     }
@@ -110,25 +138,24 @@ impl Threshold {
 /// provisionally [`PointStatus::Kept`] otherwise (also when it has no neighbour on one side:
 /// no ρ, nothing to judge). A point with no neighbour on *either* side is judged with its
 /// two adjacent points as s and t: a lone spike taller than d_b would otherwise survive
-/// §2.4 and cut the smoothed line in three. `t_off` comes from [`right_windows`]. Returns the number of
-/// irregular and non-finite points.
+/// §2.4 and cut the smoothed line in three. The offsets come from [`windows`]. Returns the
+/// number of irregular and non-finite points.
 ///
 /// No atan2: with φ = atan2(|c|, d) ∈ [0, π] and θ the threshold, φ > θ ⟺ sin(φ − θ) > 0
 /// ⟺ |c|·cos θ − d·sin θ > 0 (both sides scaled by |a||b| > 0).
 pub(crate) fn mark_irregular(
     x: &[f32],
     z: &[f32],
+    s_off: &[u8],
     t_off: &[u8],
-    d2: f32,
     thr: Threshold,
     status: &mut [PointStatus],
 ) -> (u32, u32) {
     let n = x.len();
-    let (z, t_off, status) = (&z[..n], &t_off[..n], &mut status[..n]);
+    let (z, s_off, t_off, status) = (&z[..n], &s_off[..n], &t_off[..n], &mut status[..n]);
     let (mut irregular, mut non_finite) = (0u32, 0u32);
-    let mut s = 0;
     for i in 0..n {
-        s = left_neighbour(x, z, d2, s, i);
+        let s = i - usize::from(s_off[i]);
         let t = i + usize::from(t_off[i]);
         let (xi, zi) = (x[i], z[i]);
         if !(xi.is_finite() && zi.is_finite()) {
@@ -194,20 +221,19 @@ pub(crate) fn bend_angle_deg<M: Backend>(
     }
 }
 
-/// ρ on the (smoothed) line for every point, with `t_off` from [`right_windows`]; 0 where a
+/// ρ on the (smoothed) line for every point, with the offsets from [`windows`]; 0 where a
 /// side has no neighbour.
 pub(crate) fn bend_angles<M: Backend>(
     x: &[f32],
     z: &[f32],
+    s_off: &[u8],
     t_off: &[u8],
-    d2: f32,
     rho: &mut [f32],
 ) {
     let n = x.len();
-    let (z, t_off, rho) = (&z[..n], &t_off[..n], &mut rho[..n]);
-    let mut s = 0;
+    let (z, s_off, t_off, rho) = (&z[..n], &s_off[..n], &t_off[..n], &mut rho[..n]);
     for i in 0..n {
-        s = left_neighbour(x, z, d2, s, i);
+        let s = i - usize::from(s_off[i]);
         let t = i + usize::from(t_off[i]);
         rho[i] = if s == i || t == i {
             0.0
@@ -286,21 +312,16 @@ mod tests {
     }
 
     #[test]
-    #[allow(clippy::needless_range_loop)]
     fn windows_on_a_uniform_line() {
         // Points every 0.03 m; d_b = 0.1 m reaches 3 points each side.
         let n = 20;
         let x: [f32; 20] = core::array::from_fn(|i| 1.0 + 0.03 * i as f32);
         let z = [-2.0f32; 20];
-        let mut t_off = [0u8; 20];
-        assert_eq!(right_windows(&x, &z, 0.01, &mut t_off), 0);
+        let (mut s_off, mut t_off) = ([0u8; 20], [0u8; 20]);
+        assert_eq!(windows(&x, &z, 0.01, &mut s_off, &mut t_off), 0);
         for i in 0..n {
             assert_eq!(usize::from(t_off[i]), 3.min(n - 1 - i), "t at {i}");
-        }
-        let mut s = 0;
-        for i in 0..n {
-            s = left_neighbour(&x, &z, 0.01, s, i);
-            assert_eq!(s, i.saturating_sub(3), "s at {i}");
+            assert_eq!(usize::from(s_off[i]), 3.min(i), "s at {i}");
         }
     }
 
@@ -309,14 +330,15 @@ mod tests {
         // 600 coincident points: every window would span the whole line.
         let x = [1.0f32; 600];
         let z = [-2.0f32; 600];
-        let mut t_off = [0u8; 600];
-        let capped = right_windows(&x, &z, 0.01, &mut t_off);
+        let (mut s_off, mut t_off) = ([0u8; 600], [0u8; 600]);
+        let capped = windows(&x, &z, 0.01, &mut s_off, &mut t_off);
         assert_eq!(usize::from(t_off[0]), MAX_SIDE);
         assert_eq!(usize::from(t_off[599 - 10]), 10);
-        // Points 0..=599-256 have more than MAX_SIDE points after them.
-        assert_eq!(capped as usize, 600 - MAX_SIDE - 1);
-        let s = left_neighbour(&x, &z, 0.01, 0, 400);
-        assert_eq!(s, 400 - MAX_SIDE);
+        assert_eq!(usize::from(s_off[400]), MAX_SIDE);
+        assert_eq!(usize::from(s_off[10]), 10);
+        // Points 0..=599-256 have more than MAX_SIDE points after them, points 256..=599
+        // more than MAX_SIDE before them.
+        assert_eq!(capped as usize, 2 * (600 - MAX_SIDE - 1));
     }
 
     #[test]
@@ -326,10 +348,10 @@ mod tests {
         // = 126.87°.
         let x = [1.0f32, 1.05, 1.1];
         let z = [-2.0f32, -1.9, -2.0];
-        let t_off = [1u8, 1, 0];
+        let (s_off, t_off) = ([0u8, 1, 1], [1u8, 1, 0]);
         let mut st = [PointStatus::Kept; 3];
         for (thr, expect) in [(120.0, true), (126.0, true), (127.5, false), (150.0, false)] {
-            let (irr, nf) = mark_irregular(&x, &z, &t_off, 1.0, Threshold::new(thr), &mut st);
+            let (irr, nf) = mark_irregular(&x, &z, &s_off, &t_off, Threshold::new(thr), &mut st);
             assert_eq!(nf, 0);
             assert_eq!(irr == 1, expect, "threshold {thr}");
             assert_eq!(st[1] == PointStatus::Irregular, expect);
@@ -345,10 +367,13 @@ mod tests {
     fn non_finite_points_are_marked_and_do_not_hang() {
         let x = [1.0f32, f32::NAN, 1.1, f32::INFINITY, 1.2];
         let z = [-2.0f32, -2.0, -2.0, -2.0, f32::NEG_INFINITY];
-        let mut t_off = [0u8; 5];
-        right_windows(&x, &z, 0.01, &mut t_off);
+        let (mut s_off, mut t_off) = ([0u8; 5], [0u8; 5]);
+        windows(&x, &z, 0.01, &mut s_off, &mut t_off);
+        // The finite points 0 and 2 are 0.1 apart, beyond d_b = 0.1 (squared: 0.01 vs the
+        // rounded 0.1f32²): no one has a neighbour across the NaN.
+        assert_eq!((s_off, t_off), ([0; 5], [0; 5]));
         let mut st = [PointStatus::Kept; 5];
-        let (_, nf) = mark_irregular(&x, &z, &t_off, 0.01, Threshold::new(120.0), &mut st);
+        let (_, nf) = mark_irregular(&x, &z, &s_off, &t_off, Threshold::new(120.0), &mut st);
         assert_eq!(nf, 3);
         assert_eq!(st[1], PointStatus::NonFinite);
         assert_eq!(st[3], PointStatus::NonFinite);

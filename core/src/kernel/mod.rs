@@ -21,8 +21,9 @@
 //! # Memory
 //!
 //! Per point of capacity `N`: the line's x′, z′, tag (12 bytes) plus the kernel's ρ (`f32`),
-//! status (`u8`) and one `u8` of working space (the window's right end, later the status of
-//! a kept point) — 18 bytes — plus a 1 KiB deque for the peak search and the parameters.
+//! status (`u8`) and two `u8` of working space (the window's ends as offsets; the right one
+//! later holds the status of a kept point) — 19 bytes — plus a 1 KiB deque for the peak
+//! search and the parameters.
 //! ρ's buffer doubles as the smoothing scratch before ρ is computed.
 
 use crate::math::{self, Backend};
@@ -151,6 +152,8 @@ pub struct Kernel<const N: usize> {
     status: [PointStatus; N],
     /// Per point: t(i) − i, then the status of a kept point (compact order).
     aux: [u8; N],
+    /// Per point: i − s(i).
+    s_off: [u8; N],
     /// The peak search's window-maximum deque.
     deque: [u16; seed::DEQUE_LEN],
 }
@@ -166,6 +169,7 @@ impl<const N: usize> Kernel<N> {
             rho: [0.0; N],
             status: [PointStatus::Kept; N],
             aux: [0; N],
+            s_off: [0; N],
             deque: [0; seed::DEQUE_LEN],
         }
     }
@@ -210,8 +214,9 @@ impl<const N: usize> Kernel<N> {
         let aux = &mut self.aux[..n];
 
         // 1. §2.3–2.4 on the raw line.
-        c.capped_windows += bend::right_windows(x, z, d2, aux);
-        let (irr, non_finite) = bend::mark_irregular(x, z, aux, d2, irregular, status);
+        let s_off = &mut self.s_off[..n];
+        c.capped_windows += bend::windows(x, z, d2, s_off, aux);
+        let (irr, non_finite) = bend::mark_irregular(x, z, s_off, aux, irregular, status);
         c.irregular = irr;
         c.non_finite = non_finite;
         let kept = n - (irr + non_finite) as usize;
@@ -241,18 +246,18 @@ impl<const N: usize> Kernel<N> {
         );
 
         // 4. ρ on the smoothed line.
-        c.capped_windows += bend::right_windows(xk, zk, d2, &mut aux[..kept]);
-        bend::bend_angles::<M>(xk, zk, &aux[..kept], d2, &mut rho[..kept]);
+        let s_off = &mut s_off[..kept];
+        c.capped_windows += bend::windows(xk, zk, d2, s_off, &mut aux[..kept]);
+        bend::bend_angles::<M>(xk, zk, s_off, &aux[..kept], &mut rho[..kept]);
         rho[kept..].fill(0.0);
 
         // 5. §2.6: nadir, peaks, candidates (compact indices).
         let nadir = seed::nadir(xk, zk);
         let seeds = seed::seed_candidates(
             xk,
-            zk,
             &rho[..kept],
+            s_off,
             &mut aux[..kept],
-            d2,
             p.tau_min_deg,
             p.tau_max_deg,
             nadir,

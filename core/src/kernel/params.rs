@@ -14,13 +14,14 @@
 //! | 6 | [`KernelParams::taubin_mu`] | f32 bits | [−1, 0) |
 //! | 7 | [`KernelParams::smooth_gap_m`] | f32 bits | [0, 100] |
 //! | 8 | [`KernelParams::split_gap_ns`] | u32 | any |
-//! | 9 | [`KernelParams::split_jump_m`] | f32 bits | [0, 1000] |
-//! | 10 | [`KernelParams::split_above_m`] | f32 bits | [−100, 100] |
-//! | 11–15 | reserved | 0 | 0 |
+//! | 9 | [`KernelParams::split_geometry`] | u32 | 0 = auto, 1 = always, 2 = never |
+//! | 10–15 | reserved | 0 | 0 |
 //!
 //! NaN and infinities are out of range for every f32 word. The words round-trip exactly
 //! (`from_words(p.to_words()) == Ok(p)`), and [`KernelParams::hash`] is FNV-1a over their
 //! little-endian bytes, so the same words always give the same hash on every platform.
+
+use crate::scanline::assemble::{GeometrySplit, SplitParams};
 
 /// Number of 32-bit words of the config packet's parameter block.
 pub const CONFIG_WORDS: usize = 16;
@@ -108,31 +109,20 @@ pub struct KernelParams {
     /// bends; fixing both sides of a gap keeps the paper's "ends fixed" per visible piece.
     /// 0.30 m is twice the largest spacing expected on the road (≈140 mm at the far curb).
     pub smooth_gap_m: f32,
-    /// Assembly: a pause between consecutive points longer than this ends the line,
-    /// nanoseconds (0 = off). Used only when the stream carries no line-start flags.
+    /// Assembly (`scanline::assemble`, SPEC §2 *Scanline*): a time step between
+    /// consecutive points longer than this ends the line, nanoseconds.
     ///
-    /// Default 0 (off) — the side-change rule below splits lines on its own; a scanner
-    /// integration that knows its line period may set about half of it.
+    /// Default 5 ms — the assembler's own default ([`SplitParams::DEFAULT`]): half a
+    /// revolution at 100 Hz; within a revolution points come every few µs.
     pub split_gap_ns: u32,
-    /// Assembly: a change of side of x′ between consecutive points splits the line when
-    /// the two points are more than this apart in x′, metres (a jump over the sky or the
-    /// vehicle; at the nadir consecutive points are millimetres apart, so a crossing below
-    /// the scanner never splits).
-    ///
-    /// Default 1.0 m — well above the nadir spacing (≈10 mm) and well below the jump from
-    /// one side to the other over the top (metres).
-    pub split_jump_m: f32,
-    /// Assembly: a change of side of x′ between two consecutive points that are both higher
-    /// than this (z′, metres, relative to the scanner) also splits the line — the crossing
-    /// happens above the scanner, e.g. on a tunnel ceiling or a tree canopy where
-    /// consecutive returns are close together.
-    ///
-    /// Default 0.0 m: the scanner's own height; the nadir crossing is always below it.
-    pub split_above_m: f32,
+    /// Assembly: when the geometric split rule (side change away from the nadir) is active:
+    /// 0 = until the stream's first line-start flag ([`GeometrySplit::Auto`], the default),
+    /// 1 = always, 2 = never.
+    pub split_geometry: u32,
 }
 
 /// Index of the first reserved word.
-const FIRST_RESERVED: usize = 11;
+const FIRST_RESERVED: usize = 10;
 
 impl KernelParams {
     /// The defaults (see each field for how its value was chosen).
@@ -145,9 +135,8 @@ impl KernelParams {
         taubin_lambda: 0.6307,
         taubin_mu: -0.6732,
         smooth_gap_m: 0.30,
-        split_gap_ns: 0,
-        split_jump_m: 1.0,
-        split_above_m: 0.0,
+        split_gap_ns: 5_000_000,
+        split_geometry: 0,
     };
 
     /// The parameter block as config-packet words (see the module's table).
@@ -162,8 +151,7 @@ impl KernelParams {
         w[6] = self.taubin_mu.to_bits();
         w[7] = self.smooth_gap_m.to_bits();
         w[8] = self.split_gap_ns;
-        w[9] = self.split_jump_m.to_bits();
-        w[10] = self.split_above_m.to_bits();
+        w[9] = self.split_geometry;
         w
     }
 
@@ -205,8 +193,10 @@ impl KernelParams {
         let taubin_mu = f(words, 6, -1.0, false, 0.0, true)?;
         let smooth_gap_m = f(words, 7, 0.0, false, 100.0, false)?;
         let split_gap_ns = words[8];
-        let split_jump_m = f(words, 9, 0.0, false, 1000.0, false)?;
-        let split_above_m = f(words, 10, -100.0, false, 100.0, false)?;
+        let split_geometry = words[9];
+        if split_geometry > 2 {
+            return Err(ParamsError::OutOfRange { index: 9 });
+        }
         Ok(Self {
             d_b_m,
             irregular_deg,
@@ -217,9 +207,20 @@ impl KernelParams {
             taubin_mu,
             smooth_gap_m,
             split_gap_ns,
-            split_jump_m,
-            split_above_m,
+            split_geometry,
         })
+    }
+
+    /// The assembler's part of the parameters.
+    pub fn split_params(&self) -> SplitParams {
+        SplitParams {
+            gap_ns: u64::from(self.split_gap_ns),
+            geometry: match self.split_geometry {
+                1 => GeometrySplit::Always,
+                2 => GeometrySplit::Never,
+                _ => GeometrySplit::Auto,
+            },
+        }
     }
 
     /// Checks the parameters against the ranges of the config words (the same check as
@@ -264,6 +265,18 @@ mod tests {
     }
 
     #[test]
+    fn split_params_match_the_assembler() {
+        assert_eq!(KernelParams::DEFAULT.split_params(), SplitParams::DEFAULT);
+        let p = KernelParams {
+            split_gap_ns: 7,
+            split_geometry: 2,
+            ..KernelParams::DEFAULT
+        };
+        assert_eq!(p.split_params().gap_ns, 7);
+        assert_eq!(p.split_params().geometry, GeometrySplit::Never);
+    }
+
+    #[test]
     fn word_layout_is_fixed() {
         let w = KernelParams::DEFAULT.to_words();
         assert_eq!(w[0], 0.07f32.to_bits());
@@ -291,8 +304,7 @@ mod tests {
             taubin_mu: 0.0,
             smooth_gap_m: 0.0,
             split_gap_ns: 0,
-            split_jump_m: 0.0,
-            split_above_m: 0.0,
+            split_geometry: 0,
         };
         assert_eq!(zero.hash(), expect);
         let a = KernelParams::DEFAULT;
@@ -319,7 +331,7 @@ mod tests {
             (5, 1.5f32.to_bits()),
             (6, 0.5f32.to_bits()),
             (7, f32::NEG_INFINITY.to_bits()),
-            (10, 1000.0f32.to_bits()),
+            (9, 3),
         ];
         for (index, bad) in cases {
             let mut w = good;
@@ -330,6 +342,12 @@ mod tests {
                 "word {index}"
             );
         }
+        let mut w = good;
+        w[10] = 1;
+        assert_eq!(
+            KernelParams::from_words(&w),
+            Err(ParamsError::ReservedNotZero { index: 10 })
+        );
         let mut w = good;
         w[13] = 1;
         assert_eq!(

@@ -10,10 +10,11 @@
 //!   smaller |x′| (nearer the vehicle), then the lower index.
 //!
 //! The window maximum comes from a monotone deque over the same two-index windows as ρ
-//! (both ends only move forward), so the whole pass is O(n). Its length never exceeds
-//! 2·[`MAX_SIDE`] + 2 = [`DEQUE_LEN`] (the indices between s(k−1) and t(k)).
+//! (both ends only move forward), fed lazily (see [`seed_candidates`]), so the whole pass
+//! is O(n). Its length never exceeds 2·[`MAX_SIDE`] + 2 = [`DEQUE_LEN`] (at most the
+//! indices between the previous s and the current t).
 
-use super::bend::{left_neighbour, MAX_SIDE};
+use super::bend::MAX_SIDE;
 use super::PointStatus;
 
 /// Capacity of the peak search's deque (a power of two ≥ 2·MAX_SIDE + 2).
@@ -45,16 +46,22 @@ pub(crate) struct Seeds {
     pub right: Option<usize>,
 }
 
-/// Peak search over the smoothed kept points. `aux[k]` holds t(k) − k on entry (from
-/// `bend::right_windows`) and the point's status as `u8` on return ([`PointStatus::Kept`] or
+/// Peak search over the smoothed kept points. `s_off[k]` = k − s(k) and, on entry,
+/// `aux[k]` = t(k) − k (from `bend::windows`); on return `aux[k]` holds the point's status
+/// as `u8` ([`PointStatus::Kept`] or
 /// [`PointStatus::NoNeighbour`]).
+///
+/// The window maximum is only needed where ρ_k is inside (τ_min, τ_max) — near curbs and
+/// objects, a few percent of the points — so the deque is fed lazily: at such a k it takes
+/// the indices from where it stopped (or from s(k), starting afresh, when it stopped before
+/// s(k)) up to t(k). Both window ends only move forward, so every index enters at most
+/// once: O(n) in the worst case, and nearly nothing on plain road.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn seed_candidates(
     x: &[f32],
-    z: &[f32],
     rho: &[f32],
+    s_off: &[u8],
     aux: &mut [u8],
-    d2: f32,
     tau_min: f32,
     tau_max: f32,
     nadir: Option<usize>,
@@ -62,23 +69,38 @@ pub(crate) fn seed_candidates(
 ) -> Seeds {
     const M: usize = DEQUE_LEN - 1;
     let n = x.len();
-    let (z, rho, aux) = (&z[..n], &rho[..n], &mut aux[..n]);
+    let (rho, s_off, aux) = (&rho[..n], &s_off[..n], &mut aux[..n]);
     let mut out = Seeds::default();
     // Best candidate per side: (index, |k − nadir|, |x|).
     let mut left: Option<(usize, usize, f32)> = None;
     let mut right: Option<(usize, usize, f32)> = None;
     let (mut head, mut tail) = (0usize, 0usize);
     let mut next = 0usize;
-    let mut s = 0usize;
     for k in 0..n {
-        s = left_neighbour(x, z, d2, s, k);
+        let s = k - usize::from(s_off[k]);
         let t = k + usize::from(aux[k]);
+        let no_neighbour = s == k || t == k;
+        out.no_neighbour += u32::from(no_neighbour);
+        aux[k] = if no_neighbour {
+            PointStatus::NoNeighbour as u8
+        } else {
+            PointStatus::Kept as u8
+        };
+        let r = rho[k];
+        if no_neighbour || !(r > tau_min && r < tau_max) {
+            continue;
+        }
+        // The window maximum over [s, t].
+        if next < s {
+            head = tail;
+            next = s;
+        }
         while next <= t {
-            let r = rho[next];
-            while tail > head && rho[usize::from(deque[(tail - 1) & M])] <= r {
+            let v = rho[next];
+            while tail > head && rho[usize::from(deque[(tail - 1) & M])] <= v {
                 tail -= 1;
             }
-            // next ≤ k + MAX_SIDE < n ≤ u16::MAX + 1 (the kernel caps N).
+            // next ≤ k + MAX_SIDE < n ≤ u16::MAX (the kernel caps N).
             deque[tail & M] = next as u16;
             tail += 1;
             next += 1;
@@ -87,15 +109,7 @@ pub(crate) fn seed_candidates(
         while tail > head + 1 && usize::from(deque[head & M]) < s {
             head += 1;
         }
-        let max = rho[usize::from(deque[head & M])];
-        if s == k || t == k {
-            aux[k] = PointStatus::NoNeighbour as u8;
-            out.no_neighbour += 1;
-            continue;
-        }
-        aux[k] = PointStatus::Kept as u8;
-        let r = rho[k];
-        if !(r > tau_min && r < tau_max && r >= max) {
+        if r < rho[usize::from(deque[head & M])] {
             continue;
         }
         out.peaks += 1;
@@ -121,7 +135,7 @@ pub(crate) fn seed_candidates(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kernel::bend::right_windows;
+    use crate::kernel::bend::windows;
 
     #[test]
     fn nadir_is_smallest_abs_x_below_the_scanner() {
@@ -138,20 +152,20 @@ mod tests {
         let n = x.len();
         let z = [-2.0f32; 32];
         let mut aux = [0u8; 32];
-        right_windows(x, &z[..n], d2, &mut aux[..n]);
+        let mut s_off = [0u8; 32];
+        windows(x, &z[..n], d2, &mut s_off[..n], &mut aux[..n]);
         let mut dq = [0u16; DEQUE_LEN];
-        let s = seed_candidates(
+        let seeds = seed_candidates(
             x,
-            &z[..n],
             rho,
+            &s_off[..n],
             &mut aux[..n],
-            d2,
             35.0,
             150.0,
             nadir,
             &mut dq,
         );
-        (s, aux)
+        (seeds, aux)
     }
 
     #[test]

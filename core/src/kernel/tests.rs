@@ -388,7 +388,7 @@ fn memory_budget() {
             "N = {m}: Kernel {k} B, Line {l} B, together {} B = {:.2} B/point + {} B",
             k + l,
             (k + l) as f64 / m as f64,
-            k + l - 18 * m
+            k + l - 19 * m
         );
     }
 }
@@ -611,4 +611,74 @@ fn parameter_study() {
             libm::sqrt(sum2 / cnt.max(1) as f64) * 1e3
         );
     }
+}
+
+/// Minimum and median of per-call wall times, ns per point.
+fn min_med(n: usize, reps: usize, mut f: impl FnMut()) -> (f64, f64) {
+    let mut v: Vec<f64> = (0..reps)
+        .map(|_| {
+            let t0 = std::time::Instant::now();
+            f();
+            t0.elapsed().as_nanos() as f64 / n as f64
+        })
+        .collect();
+    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    (v[0], v[reps / 2])
+}
+
+/// Where the time goes: each stage on one synthetic 2000-point line, minimum and median of
+/// 2000 runs (the minimum is the uncontended speed on a shared machine). Run with
+/// `cargo test --release -p curbtrace-core --lib stage_timings -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn stage_timings() {
+    let mut buf = std::vec![(0f32, 0f32, 0u32); N];
+    let n = Scene::DEFAULT.generate(&mut Rng(1), &mut buf);
+    let x: Vec<f32> = buf[..n].iter().map(|p| p.0).collect();
+    let z: Vec<f32> = buf[..n].iter().map(|p| p.1).collect();
+    let (mut s_off, mut t_off) = (std::vec![0u8; n], std::vec![0u8; n]);
+    let d2 = 0.07f32 * 0.07;
+    let r = min_med(n, 2000, || {
+        bend::windows(core::hint::black_box(&x), &z, d2, &mut s_off, &mut t_off);
+    });
+    std::println!("windows: {r:.1?} ns/pt");
+    let mut rho = std::vec![0f32; n];
+    let r = min_med(n, 2000, || {
+        bend::bend_angles::<crate::math::Selected>(
+            core::hint::black_box(&x),
+            &z,
+            &s_off,
+            &t_off,
+            &mut rho,
+        )
+    });
+    std::println!("bend_angles: {r:.1?} ns/pt");
+    let (mut xs, mut zs) = (x.clone(), z.clone());
+    let r = min_med(n, 2000, || {
+        smooth::taubin_smooth(
+            core::hint::black_box(&mut xs),
+            &mut zs,
+            &mut rho,
+            0.3,
+            20,
+            0.6307,
+            -0.6732,
+        );
+    });
+    std::println!("taubin: {r:.1?} ns/pt");
+    let mut acc = 0.0f32;
+    let r = min_med(n, 2000, || {
+        for (a, b) in core::hint::black_box(&x).iter().zip(&z) {
+            acc += a * b;
+        }
+    });
+    std::println!("plain dependent add (latency reference): {r:.2?} ns/pt {acc}");
+    let mut lines: Vec<Line<N>> = (0..400).map(|_| line_from(&buf[..n])).collect();
+    let mut k = Kernel::<N>::new(KernelParams::DEFAULT);
+    let mut it = lines.iter_mut();
+    let r = min_med(n, 400, || {
+        let out = k.process(it.next().unwrap());
+        core::hint::black_box(out.left);
+    });
+    std::println!("whole process: {r:.1?} ns/pt");
 }

@@ -525,13 +525,27 @@ impl ConfigRepr {
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
     use super::*;
     use proptest::prelude::*;
 
     /// A config packet, byte by byte (see `docs/wire-format.md`).
     fn golden_config() -> [u8; CONFIG_PACKET_LEN] {
         let mut g = [0u8; CONFIG_PACKET_LEN];
-        g[..12].copy_from_slice(&[0xA5, 0xC3, 0x01, 0x02, 0x50, 0x00, 0x00, 0x00, 7, 0, 0, 0]);
+        g[..12].copy_from_slice(&[
+            0xA5,
+            0xC3,
+            0x01,
+            0x02,
+            CONFIG_PACKET_LEN as u8,
+            0x00,
+            0x00,
+            0x00,
+            7,
+            0,
+            0,
+            0,
+        ]);
         for i in 0..CONFIG_WORDS {
             g[12 + 4 * i..16 + 4 * i].copy_from_slice(&(i as u32 * 0x0101_0101).to_le_bytes());
         }
@@ -566,10 +580,10 @@ mod tests {
             }
         );
         assert_eq!(
-            Packet::new_checked(&g[..79]).unwrap_err(),
+            Packet::new_checked(&g[..CONFIG_PACKET_LEN - 1]).unwrap_err(),
             Error::Truncated {
-                needed: 80,
-                available: 79
+                needed: CONFIG_PACKET_LEN,
+                available: CONFIG_PACKET_LEN - 1
             }
         );
         let mut b = g;
@@ -590,8 +604,8 @@ mod tests {
         // Valid CRC but a reserved flag set: rejected (canonical format).
         let mut b = g;
         b[6] = 1;
-        let crc = crc::crc32(&b[..76]);
-        b[76..].copy_from_slice(&crc.to_le_bytes());
+        let crc = crc::crc32(&b[..CONFIG_PACKET_LEN - 4]);
+        b[CONFIG_PACKET_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
         assert_eq!(
             ConfigRepr::parse(&Packet::new_unchecked(&b[..])),
             Err(Error::ReservedNotZero { offset: 6 })
@@ -599,8 +613,8 @@ mod tests {
         // Version 2 with a valid CRC.
         let mut b = g;
         b[2] = 2;
-        let crc = crc::crc32(&b[..76]);
-        b[76..].copy_from_slice(&crc.to_le_bytes());
+        let crc = crc::crc32(&b[..CONFIG_PACKET_LEN - 4]);
+        b[CONFIG_PACKET_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
         assert_eq!(
             ConfigRepr::parse(&Packet::new_unchecked(&b[..])),
             Err(Error::BadVersion { version: 2 })
@@ -625,8 +639,8 @@ mod tests {
 
     proptest! {
         #[test]
-        fn config_roundtrip(words in proptest::array::uniform16(any::<u32>()), seq in any::<u32>()) {
-            let r = ConfigRepr { words };
+        fn config_roundtrip(v in proptest::collection::vec(any::<u32>(), CONFIG_WORDS), seq in any::<u32>()) {
+            let r = ConfigRepr { words: v.try_into().unwrap() };
             let mut out = [0u8; CONFIG_PACKET_LEN];
             prop_assert_eq!(r.emit(seq, &mut out), Ok(CONFIG_PACKET_LEN));
             let p = Packet::new_checked(&out[..]).unwrap();
@@ -637,12 +651,12 @@ mod tests {
         /// emit ∘ parse is the identity on canonical bytes: any mutation that still parses
         /// re-emits to the same bytes.
         #[test]
-        fn config_canonical(words in proptest::array::uniform16(any::<u32>()), at in 0usize..76, val in any::<u8>()) {
+        fn config_canonical(v in proptest::collection::vec(any::<u32>(), CONFIG_WORDS), at in 0usize..CONFIG_PACKET_LEN - 4, val in any::<u8>()) {
             let mut b = [0u8; CONFIG_PACKET_LEN];
-            ConfigRepr { words }.emit(1, &mut b).unwrap();
+            ConfigRepr { words: v.try_into().unwrap() }.emit(1, &mut b).unwrap();
             b[at] = val;
-            let crc = crc::crc32(&b[..76]);
-            b[76..].copy_from_slice(&crc.to_le_bytes());
+            let crc = crc::crc32(&b[..CONFIG_PACKET_LEN - 4]);
+            b[CONFIG_PACKET_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
             let p = Packet::new_unchecked(&b[..]);
             if let Ok(r) = ConfigRepr::parse(&p) {
                 let mut again = [0u8; CONFIG_PACKET_LEN];

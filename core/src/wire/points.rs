@@ -248,8 +248,30 @@ pub(crate) mod tests {
         0x32, 0x98, 0xF6, 0xB6, // CRC-32
     ];
 
+    /// Reads the hexdump between the `hexdump:points` markers of `docs/wire-format.md`.
+    fn doc_hexdump() -> heapless::Vec<u8, 256> {
+        let doc = include_str!("../../../docs/wire-format.md");
+        let start = doc.find("<!-- hexdump:points -->").unwrap();
+        let end = doc[start..].find("<!-- /hexdump -->").unwrap() + start;
+        let mut out = heapless::Vec::new();
+        for line in doc[start..end].lines() {
+            // "0000  a5 c3 …": an offset, then hex bytes.
+            let mut words = line.split_whitespace();
+            let Some(off) = words.next() else { continue };
+            if off.len() != 4 || usize::from_str_radix(off, 16).is_err() {
+                continue;
+            }
+            assert_eq!(usize::from_str_radix(off, 16).unwrap(), out.len());
+            for w in words {
+                out.push(u8::from_str_radix(w, 16).unwrap()).unwrap();
+            }
+        }
+        out
+    }
+
     #[test]
     fn doc_hexdump_decodes() {
+        assert_eq!(&doc_hexdump()[..], &DOC_EXAMPLE[..]);
         let p = Packet::new_checked(&DOC_EXAMPLE[..]).unwrap();
         assert_eq!(p.check(), Ok(PacketKind::Points));
         assert_eq!(p.seq(), 1);

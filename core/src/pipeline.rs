@@ -1,0 +1,384 @@
+//! [`Pipeline`]: the whole on-board path — bytes in, one [`ScanlineOutput`] per line out —
+//! as the firmware's main loop and host-sim's in-process replay both run it.
+//!
+//! ```
+//! use curbtrace_core::pipeline::{encode_output, Pipeline};
+//! use curbtrace_core::wire::{PointRecord, StreamEncoder, MAX_PACKET_LEN};
+//!
+//! // A stream: one points packet holding a short flat line under the scanner.
+//! let mut enc = StreamEncoder::new();
+//! let points: Vec<PointRecord> = (0..50)
+//!     .map(|i| PointRecord {
+//!         dt_ns: 5_000 * i,
+//!         x_m: -0.25 + 0.01 * i as f32,
+//!         z_m: -2.0,
+//!         intensity: 0,
+//!         line_start: i == 0,
+//!         tag: i,
+//!     })
+//!     .collect();
+//! let mut bytes = vec![0u8; MAX_PACKET_LEN];
+//! let n = enc.encode_points(1_000_000_000, &points, &mut bytes).unwrap();
+//!
+//! let mut p = Box::new(Pipeline::<4096, 2048>::new());
+//! assert_eq!(p.write(&bytes[..n]), n);
+//! let mut out_enc = StreamEncoder::new();
+//! let mut packet = vec![0u8; 4 * MAX_PACKET_LEN];
+//! let mut lines = 0;
+//! p.finish(|out| {
+//!     lines += 1;
+//!     assert_eq!(out.status.len(), 50);
+//!     assert!(encode_output(out, &mut out_enc, &mut packet).unwrap() > 0);
+//! });
+//! assert_eq!(lines, 1);
+//! assert_eq!(p.counters().kernel_points, 50);
+//! ```
+
+use crate::kernel::{Kernel, KernelParams, ParamsError, PointStatus, ScanlineOutput};
+use crate::scanline::{Ingest, IngestCounters, IngestEvent};
+use crate::wire::{EncodeError, OutputHeaderRepr, OutputPointRepr, StreamEncoder};
+
+/// Everything the pipeline counted: ingest's counters plus the kernel's, summed over lines,
+/// and the config packets.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PipelineCounters {
+    /// Bytes, packets, points and lines as ingest counted them.
+    pub ingest: IngestCounters,
+    /// Lines processed by the kernel.
+    pub kernel_lines: u64,
+    /// Points that entered the kernel (= the sum of the status counts below).
+    pub kernel_points: u64,
+    /// Points with status [`PointStatus::Kept`].
+    pub kept: u64,
+    /// Points with status [`PointStatus::Irregular`].
+    pub irregular: u64,
+    /// Points with status [`PointStatus::NoNeighbour`].
+    pub no_neighbour: u64,
+    /// Points with status [`PointStatus::NonFinite`].
+    pub non_finite: u64,
+    /// Peaks found.
+    pub peaks: u64,
+    /// Lines with a left candidate.
+    pub left_candidates: u64,
+    /// Lines with a right candidate.
+    pub right_candidates: u64,
+    /// Config packets whose parameters were applied.
+    pub configs_applied: u64,
+    /// Config packets rejected (parameters out of range); the previous ones stayed.
+    pub configs_rejected: u64,
+    /// Why the last config packet was rejected, if one was.
+    pub last_config_error: Option<ParamsError>,
+}
+
+/// Ingest (ring, parser, assembly) and the kernel, for lines of up to `N` points and a ring
+/// of `RING` bytes. Starts with [`KernelParams::DEFAULT`]; a config packet in the stream
+/// reconfigures the kernel and the assembler from the next line on.
+pub struct Pipeline<const RING: usize, const N: usize> {
+    ingest: Ingest<RING, N>,
+    kernel: Kernel<N>,
+    c: PipelineCounters,
+}
+
+impl<const RING: usize, const N: usize> Pipeline<RING, N> {
+    /// A pipeline with the default parameters.
+    pub fn new() -> Self {
+        let params = KernelParams::DEFAULT;
+        let mut ingest = Ingest::new();
+        ingest.set_split_params(params.split_params());
+        Self {
+            ingest,
+            kernel: Kernel::new(params),
+            c: PipelineCounters::default(),
+        }
+    }
+
+    /// Offers bytes; returns how many were accepted (the rest is counted as dropped).
+    pub fn write(&mut self, bytes: &[u8]) -> usize {
+        self.ingest.write(bytes)
+    }
+
+    /// Processes every complete line in the ring, calling `on_line` with each result; a
+    /// config packet reconfigures the kernel (bad ones are counted, the old parameters stay).
+    pub fn run(&mut self, mut on_line: impl FnMut(&ScanlineOutput<'_>)) {
+        while let Some(ev) = self.ingest.poll() {
+            match ev {
+                IngestEvent::Config(words) => {
+                    match KernelParams::from_words(&words)
+                        .and_then(|p| self.kernel.set_params(p).map(|()| p))
+                    {
+                        Ok(p) => {
+                            self.ingest.set_split_params(p.split_params());
+                            self.c.configs_applied += 1;
+                        }
+                        Err(e) => {
+                            self.c.configs_rejected += 1;
+                            self.c.last_config_error = Some(e);
+                        }
+                    }
+                }
+                IngestEvent::Line(line) => {
+                    let out = self.kernel.process(line);
+                    let k = out.counters;
+                    let c = &mut self.c;
+                    c.kernel_lines += 1;
+                    c.kernel_points += u64::from(k.points_in);
+                    c.kept += u64::from(k.kept);
+                    c.irregular += u64::from(k.irregular);
+                    c.no_neighbour += u64::from(k.no_neighbour);
+                    c.non_finite += u64::from(k.non_finite);
+                    c.peaks += u64::from(k.peaks);
+                    c.left_candidates += u64::from(out.left.is_some());
+                    c.right_candidates += u64::from(out.right.is_some());
+                    on_line(&out);
+                }
+            }
+        }
+    }
+
+    /// End of stream: the partial last line is completed and processed like the others.
+    pub fn finish(&mut self, on_line: impl FnMut(&ScanlineOutput<'_>)) {
+        self.ingest.finish();
+        self.run(on_line);
+    }
+
+    /// The counters so far.
+    pub fn counters(&self) -> PipelineCounters {
+        PipelineCounters {
+            ingest: self.ingest.counters(),
+            ..self.c
+        }
+    }
+
+    /// The kernel parameters in force.
+    pub fn params(&self) -> &KernelParams {
+        self.kernel.params()
+    }
+}
+
+impl<const RING: usize, const N: usize> Default for Pipeline<RING, N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Writes all output packets of one line back to back into `buf` (see
+/// `docs/wire-format.md`); returns the bytes written. `buf` needs
+/// `wire::output_packet_len` of each fragment — at most
+/// ⌈len / `MAX_OUTPUT_POINTS_PER_PACKET`⌉ · `MAX_PACKET_LEN` bytes. Counters above 65 535
+/// saturate in the header's 16-bit fields. A non-finite point (status
+/// [`PointStatus::NonFinite`], which ingest normally drops before the kernel) is sent at
+/// x′ = z′ = 0 with its status, so the line still encodes.
+pub fn encode_output(
+    out: &ScanlineOutput<'_>,
+    enc: &mut StreamEncoder,
+    buf: &mut [u8],
+) -> Result<usize, EncodeError> {
+    let sat = |v: u32| u16::try_from(v).unwrap_or(u16::MAX);
+    let line_len = u16::try_from(out.status.len()).map_err(|_| EncodeError::TooManyPoints {
+        count: out.status.len(),
+        max: usize::from(u16::MAX),
+    })?;
+    let header = OutputHeaderRepr {
+        index: out.index,
+        start_time_ns: out.start_time_ns,
+        params_hash: out.params_hash,
+        truncated: out.truncated,
+        line_len,
+        first: 0,
+        nadir: out.nadir,
+        left: out.left,
+        right: out.right,
+        kept: sat(out.counters.kept),
+        irregular: sat(out.counters.irregular),
+        no_neighbour: sat(out.counters.no_neighbour),
+        peaks: sat(out.counters.peaks),
+    };
+    enc.encode_output_line(
+        &header,
+        |i| {
+            let status = *out
+                .status
+                .get(i)
+                .ok_or(EncodeError::OutOfRange { index: i })?;
+            let get = |s: &[f32]| s.get(i).copied().unwrap_or(0.0);
+            let (x, z) = if status == PointStatus::NonFinite {
+                (0.0, 0.0)
+            } else {
+                (get(out.x_m), get(out.z_m))
+            };
+            let tag = out.tag.get(i).copied().unwrap_or(0);
+            OutputPointRepr::from_f32(tag, x, z, get(out.rho_deg), status as u8, i)
+        },
+        buf,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::wire::{
+        scan, Packet, PacketKind, PointRecord, Scan, MAX_OUTPUT_POINTS_PER_PACKET, MAX_PACKET_LEN,
+        MAX_POINTS_PER_PACKET,
+    };
+    use std::vec::Vec;
+
+    const RING: usize = 16384;
+    const N: usize = 4096;
+
+    /// A stream of `lines` flat lines of 300 points with a 150 mm step at x′ = +1 m, flags set.
+    fn stream(enc: &mut StreamEncoder, lines: u32, out: &mut Vec<u8>) {
+        let mut buf = std::vec![0u8; MAX_PACKET_LEN];
+        for l in 0..lines {
+            let pts: Vec<PointRecord> = (0..300u32)
+                .map(|i| {
+                    let x = -1.0 + 0.01 * i as f32;
+                    let (x, z) = if i < 200 {
+                        (x, -2.0)
+                    } else if i < 215 {
+                        (1.0, -2.0 + 0.01 * (i - 200) as f32)
+                    } else {
+                        (1.0 + 0.01 * (i - 215) as f32, -1.85)
+                    };
+                    PointRecord {
+                        dt_ns: 1000 * i,
+                        x_m: x,
+                        z_m: z,
+                        intensity: 0,
+                        line_start: i == 0,
+                        tag: l * 1000 + i,
+                    }
+                })
+                .collect();
+            for chunk in pts.chunks(MAX_POINTS_PER_PACKET) {
+                let first = chunk[0].dt_ns;
+                let rebased: Vec<PointRecord> = chunk
+                    .iter()
+                    .map(|p| PointRecord {
+                        dt_ns: p.dt_ns - first,
+                        ..*p
+                    })
+                    .collect();
+                let base = 1_000_000_000 + u64::from(l) * 10_000_000 + u64::from(first);
+                let n = enc.encode_points(base, &rebased, &mut buf).unwrap();
+                out.extend_from_slice(&buf[..n]);
+            }
+        }
+    }
+
+    #[test]
+    fn lines_flow_through_and_every_point_is_counted() {
+        let mut enc = StreamEncoder::new();
+        let mut bytes = Vec::new();
+        stream(&mut enc, 3, &mut bytes);
+        let mut p = std::boxed::Box::new(Pipeline::<RING, N>::new());
+        let mut seen = Vec::new();
+        for chunk in bytes.chunks(1000) {
+            assert_eq!(p.write(chunk), chunk.len());
+            p.run(|o| seen.push((o.index, o.status.len(), o.left, o.tag[0])));
+        }
+        p.finish(|o| seen.push((o.index, o.status.len(), o.left, o.tag[0])));
+        assert_eq!(seen.len(), 3);
+        for (l, s) in seen.iter().enumerate() {
+            // The toe is point 200 of each line.
+            assert_eq!(*s, (l as u32, 300, Some(200), l as u32 * 1000));
+        }
+        let c = p.counters();
+        assert_eq!(c.kernel_lines, 3);
+        assert_eq!(c.kernel_points, 900);
+        assert_eq!(c.ingest.points_in_lines, 900);
+        assert_eq!(c.kept + c.irregular + c.no_neighbour + c.non_finite, 900);
+        assert_eq!(c.left_candidates, 3);
+        assert_eq!(c.right_candidates, 0);
+    }
+
+    #[test]
+    fn config_packets_reconfigure_and_bad_ones_are_counted() {
+        let mut enc = StreamEncoder::new();
+        let mut bytes = Vec::new();
+        let mut buf = [0u8; MAX_PACKET_LEN];
+        // A good config: d_b = 0.05.
+        let good = KernelParams {
+            d_b_m: 0.05,
+            ..KernelParams::DEFAULT
+        };
+        let n = enc.encode_config(&good.to_words(), &mut buf).unwrap();
+        bytes.extend_from_slice(&buf[..n]);
+        stream(&mut enc, 1, &mut bytes);
+        // A bad one: NaN d_b.
+        let mut w = good.to_words();
+        w[0] = f32::NAN.to_bits();
+        let n = enc.encode_config(&w, &mut buf).unwrap();
+        bytes.extend_from_slice(&buf[..n]);
+        stream(&mut enc, 1, &mut bytes);
+        let mut p = std::boxed::Box::new(Pipeline::<RING, N>::new());
+        let mut hashes = Vec::new();
+        for chunk in bytes.chunks(4000) {
+            p.write(chunk);
+            p.run(|o| hashes.push(o.params_hash));
+        }
+        p.finish(|o| hashes.push(o.params_hash));
+        assert_eq!(hashes, [good.hash(), good.hash()]);
+        let c = p.counters();
+        assert_eq!(c.configs_applied, 1);
+        assert_eq!(c.configs_rejected, 1);
+        assert_eq!(
+            c.last_config_error,
+            Some(ParamsError::OutOfRange { index: 0 })
+        );
+        assert_eq!(p.params().d_b_m, 0.05);
+    }
+
+    #[test]
+    fn output_packets_carry_the_line() {
+        let mut enc = StreamEncoder::new();
+        let mut bytes = Vec::new();
+        stream(&mut enc, 1, &mut bytes);
+        let mut p = std::boxed::Box::new(Pipeline::<RING, N>::new());
+        p.write(&bytes);
+        let mut packets = std::vec![0u8; 8 * MAX_PACKET_LEN];
+        let mut out_enc = StreamEncoder::new();
+        let mut written = 0;
+        let mut expect: Vec<(u32, f32, f32, f32, u8)> = Vec::new();
+        p.finish(|o| {
+            written = encode_output(o, &mut out_enc, &mut packets).unwrap();
+            for i in 0..o.status.len() {
+                expect.push((
+                    o.tag[i],
+                    o.x_m[i],
+                    o.z_m[i],
+                    o.rho_deg[i],
+                    o.status[i] as u8,
+                ));
+            }
+        });
+        // Decode the packets back and compare point by point.
+        let mut at = 0;
+        let mut got = Vec::new();
+        let mut fragments = 0;
+        while at < written {
+            let Scan::Packet { len, .. } = scan(&packets[at..written], true) else {
+                panic!("no packet at {at}");
+            };
+            let pk = Packet::new_checked(&packets[at..at + len]).unwrap();
+            assert_eq!(pk.kind(), Some(PacketKind::Output));
+            let (h, pts) = OutputHeaderRepr::parse(&pk).unwrap();
+            assert_eq!(h.line_len, 300);
+            assert_eq!(h.left, Some(200));
+            assert_eq!(h.params_hash, KernelParams::DEFAULT.hash());
+            got.extend(pts);
+            fragments += 1;
+            at += len;
+        }
+        assert_eq!(fragments, 300usize.div_ceil(MAX_OUTPUT_POINTS_PER_PACKET));
+        assert_eq!(got.len(), 300);
+        for (g, e) in got.iter().zip(&expect) {
+            assert_eq!(g.tag, e.0);
+            assert!((g.x_m() - f64::from(e.1)).abs() < 1e-6);
+            assert!((g.z_m() - f64::from(e.2)).abs() < 1e-6);
+            assert!((g.rho_deg() - f64::from(e.3)).abs() <= 0.005 + 1e-9);
+            assert_eq!(g.status, e.4);
+        }
+    }
+}
