@@ -279,11 +279,19 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
     fn step(&mut self) -> Step {
         if let Some(mut cur) = self.cur {
             while cur.next < cur.count {
-                let mut rec = [0u8; POINT_RECORD_LEN];
                 let at = HEADER_LEN + POINTS_PREFIX_LEN + cur.next * POINT_RECORD_LEN;
-                // In the ring: the scanner checked the whole packet is there.
-                let _ = self.ring.peek(at, &mut rec);
-                let p = match PointRecord::parse(&rec) {
+                // Parse in place when the record is contiguous; copy it out only when it
+                // straddles the ring's seam. The scanner checked the packet is all there.
+                let (a, _) = self.ring.as_slices();
+                let parsed = match a.get(at..at + POINT_RECORD_LEN) {
+                    Some(rec) => PointRecord::parse(rec),
+                    None => {
+                        let mut rec = [0u8; POINT_RECORD_LEN];
+                        let _ = self.ring.peek(at, &mut rec);
+                        PointRecord::parse(&rec)
+                    }
+                };
+                let p = match parsed {
                     Ok(p) => p,
                     Err(e) => {
                         cur.next += 1;
