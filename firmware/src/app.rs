@@ -5,15 +5,23 @@
 //! The links are `embedded_io::{Read, Write}` (embedded-hal 1.0 has no serial traits), so
 //! a UART, SPI or DMA driver replaces the semihosting files of the QEMU build without this
 //! loop changing.
+//!
+//! [`Node`] is `curbtrace_core::pipeline::Pipeline` taken apart, for two reasons of memory:
+//! `Pipeline::new()` returns its ~80 KiB by value, which passes through the stack (the
+//! firmware's stack is far smaller), while [`Node::init`] builds ingest and kernel in place;
+//! and `pipeline::encode_output` needs a whole line's packets in one buffer (35 KiB for
+//! 2048 points), while [`emit_line`] sends one packet at a time. The per-event logic is
+//! `Pipeline::run`'s and the bytes are `encode_output`'s: `firmware/check.sh` compares the
+//! firmware's output with `curbtrace kernel`, which runs `Pipeline` and `encode_output`.
 
-use curbtrace_core::kernel::{Kernel, KernelCounters, KernelParams, ScanlineOutput};
+use core::mem::MaybeUninit;
+use core::ptr::addr_of_mut;
+use curbtrace_core::kernel::{Kernel, KernelCounters, KernelParams, PointStatus, ScanlineOutput};
 use curbtrace_core::scanline::{Ingest, IngestCounters, IngestEvent};
 use curbtrace_core::wire::{
     EncodeError, OutputHeaderRepr, OutputPointRepr, StreamEncoder, MAX_OUTPUT_POINTS_PER_PACKET,
     MAX_PACKET_LEN, MAX_POINTS_PER_PACKET, POINTS_PREFIX_LEN, POINT_RECORD_LEN,
 };
-use core::mem::MaybeUninit;
-use core::ptr::addr_of_mut;
 
 use embedded_io::{Read, Write};
 
@@ -46,8 +54,10 @@ pub struct Node<const RING: usize, const N: usize> {
 impl<const RING: usize, const N: usize> Node<RING, N> {
     /// An empty node running the default parameters until the stream's config packet.
     pub fn new() -> Self {
+        let mut ingest = Ingest::new();
+        ingest.set_split_params(KernelParams::DEFAULT.split_params());
         Self {
-            ingest: Ingest::new(),
+            ingest,
             kernel: Kernel::new(KernelParams::DEFAULT),
         }
     }
@@ -63,7 +73,10 @@ impl<const RING: usize, const N: usize> Node<RING, N> {
         unsafe {
             addr_of_mut!((*p).ingest).write(Ingest::new());
             addr_of_mut!((*p).kernel).write(Kernel::new(KernelParams::DEFAULT));
-            &mut *p
+            let node = &mut *p;
+            node.ingest
+                .set_split_params(KernelParams::DEFAULT.split_params());
+            node
         }
     }
 }
@@ -149,8 +162,15 @@ fn drain<W: Write, E, const RING: usize, const N: usize>(
     while let Some(event) = node.ingest.poll() {
         match event {
             IngestEvent::Config(words) => {
-                match KernelParams::from_words(&words).and_then(|p| node.kernel.set_params(p)) {
-                    Ok(()) => sum.configs += 1,
+                // As Pipeline::run: kernel and assembler from the next line on; a bad block
+                // is counted and the old parameters stay.
+                match KernelParams::from_words(&words)
+                    .and_then(|p| node.kernel.set_params(p).map(|()| p))
+                {
+                    Ok(p) => {
+                        node.ingest.set_split_params(p.split_params());
+                        sum.configs += 1;
+                    }
                     Err(_) => sum.configs_rejected += 1,
                 }
             }
@@ -176,25 +196,46 @@ fn add_counters(total: &mut KernelCounters, c: &KernelCounters) {
     total.smooth_pieces += c.smooth_pieces;
 }
 
-/// The wire header of a line's output.
+/// The wire header of a line's output, as `pipeline::encode_output` builds it (counters
+/// above 65 535 saturate; they cannot reach that with 2048-point lines).
 pub fn output_header(out: &ScanlineOutput<'_>) -> Result<OutputHeaderRepr, EncodeError> {
-    let n = out.tag.len();
-    let u16_of = |v: u32| u16::try_from(v).map_err(|_| EncodeError::OutOfRange { index: n });
+    let sat = |v: u32| u16::try_from(v).unwrap_or(u16::MAX);
+    let n = out.status.len();
     Ok(OutputHeaderRepr {
         index: out.index,
         start_time_ns: out.start_time_ns,
         params_hash: out.params_hash,
         truncated: out.truncated,
-        line_len: u16::try_from(n).map_err(|_| EncodeError::OutOfRange { index: n })?,
+        line_len: u16::try_from(n).map_err(|_| EncodeError::TooManyPoints {
+            count: n,
+            max: usize::from(u16::MAX),
+        })?,
         first: 0,
         nadir: out.nadir,
         left: out.left,
         right: out.right,
-        kept: u16_of(out.counters.kept)?,
-        irregular: u16_of(out.counters.irregular)?,
-        no_neighbour: u16_of(out.counters.no_neighbour)?,
-        peaks: u16_of(out.counters.peaks)?,
+        kept: sat(out.counters.kept),
+        irregular: sat(out.counters.irregular),
+        no_neighbour: sat(out.counters.no_neighbour),
+        peaks: sat(out.counters.peaks),
     })
+}
+
+/// Output point `i` of a line, as `pipeline::encode_output` converts it (a non-finite point
+/// goes out at x′ = z′ = 0 with its status).
+pub fn output_point(out: &ScanlineOutput<'_>, i: usize) -> Result<OutputPointRepr, EncodeError> {
+    let status = *out
+        .status
+        .get(i)
+        .ok_or(EncodeError::OutOfRange { index: i })?;
+    let get = |s: &[f32]| s.get(i).copied().unwrap_or(0.0);
+    let (x, z) = if status == PointStatus::NonFinite {
+        (0.0, 0.0)
+    } else {
+        (get(out.x_m), get(out.z_m))
+    };
+    let tag = out.tag.get(i).copied().unwrap_or(0);
+    OutputPointRepr::from_f32(tag, x, z, get(out.rho_deg), status as u8, i)
 }
 
 /// Writes one line's output packets, one packet buffer at a time (a whole 2048-point line
@@ -207,21 +248,7 @@ fn emit_line<W: Write, E>(
     sum: &mut Summary,
 ) -> Result<(), Error<E, W::Error>> {
     let header = output_header(out).map_err(|e| Error::Encode(out.index, e))?;
-    let point = |i: usize| {
-        let get = || -> Option<OutputPointRepr> {
-            let status = *out.status.get(i)? as u8;
-            OutputPointRepr::from_f32(
-                *out.tag.get(i)?,
-                *out.x_m.get(i)?,
-                *out.z_m.get(i)?,
-                *out.rho_deg.get(i)?,
-                status,
-                i,
-            )
-            .ok()
-        };
-        get().ok_or(EncodeError::OutOfRange { index: i })
-    };
+    let point = |i: usize| output_point(out, i);
     for k in 0..header.fragments() {
         let first = u16::try_from(k * MAX_OUTPUT_POINTS_PER_PACKET)
             .map_err(|_| Error::Encode(out.index, EncodeError::OutOfRange { index: k }))?;
@@ -295,7 +322,8 @@ mod tests {
                 })
                 .collect();
             for (c, chunk) in pts.chunks(MAX_POINTS_PER_PACKET).enumerate() {
-                let base = 1_000_000_000 * (l as u64 + 1) + (c * MAX_POINTS_PER_PACKET) as u64 * 1000;
+                let base =
+                    1_000_000_000 * (l as u64 + 1) + (c * MAX_POINTS_PER_PACKET) as u64 * 1000;
                 let k = enc.encode_points(base, chunk, &mut buf).unwrap();
                 out.extend_from_slice(&buf[..k]);
             }
@@ -307,8 +335,13 @@ mod tests {
         let mut node: Box<Node<RING, 512>> = Box::default();
         let mut packet = [0u8; MAX_PACKET_LEN];
         let mut out = Sink(Vec::new());
-        let sum = run(&mut node, &mut Trickle { data: input, step }, &mut out, &mut packet)
-            .expect("runs");
+        let sum = run(
+            &mut node,
+            &mut Trickle { data: input, step },
+            &mut out,
+            &mut packet,
+        )
+        .expect("runs");
         (sum, out.0)
     }
 
@@ -337,7 +370,11 @@ mod tests {
             let p = Packet::new_unchecked(&whole[at..at + len]);
             let (h, _) = OutputHeaderRepr::parse(&p).unwrap();
             assert_eq!(h.line_len, 300);
-            assert!(h.nadir.is_some_and(|i| (145..=155).contains(&i)), "{:?}", h.nadir);
+            assert!(
+                h.nadir.is_some_and(|i| (145..=155).contains(&i)),
+                "{:?}",
+                h.nadir
+            );
             at += len;
         }
     }
