@@ -5,4 +5,5 @@
 #![cfg_attr(not(test), no_std)]
 #![deny(missing_docs)]
 
+pub mod app;
 pub mod args;

@@ -17,9 +17,13 @@ mod stack;
 
 use curbtrace_firmware::args::{self, Command};
 
+use core::mem::MaybeUninit;
+use core::ptr::addr_of_mut;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
-use embedded_io::{Read, Write};
+
+use curbtrace_core::wire::MAX_PACKET_LEN;
+use curbtrace_firmware::app::{self, Node, MAX_POINTS, RING};
 
 use semihosting_io::{HostFile, Mode};
 
@@ -50,8 +54,6 @@ macro_rules! fail {
         }
     }};
 }
-
-const CHUNK: usize = 512;
 
 #[entry]
 fn main() -> ! {
@@ -91,24 +93,42 @@ fn main() -> ! {
             exit_failure()
         }
     };
-    let mut chunk = [0u8; CHUNK];
-    let mut total = 0usize;
-    loop {
-        let n = match input.read(&mut chunk) {
-            Ok(0) => break,
-            Ok(n) => n,
-            Err(e) => {
-                fail!("reading input: {}", e);
-                exit_failure()
-            }
-        };
-        total += n;
-        if let Err(e) = output.write_all(&chunk[..n]) {
-            fail!("writing output: {}", e);
+    // All the core's working memory, in .bss: constructed in place, never on the stack.
+    static mut NODE: MaybeUninit<Node<RING, MAX_POINTS>> = MaybeUninit::uninit();
+    static mut PACKET: [u8; MAX_PACKET_LEN] = [0; MAX_PACKET_LEN];
+    // SAFETY: main runs once and no interrupt touches these; these are the only references.
+    let (node, packet) = unsafe {
+        (
+            Node::init(&mut *addr_of_mut!(NODE)),
+            &mut *addr_of_mut!(PACKET),
+        )
+    };
+    let summary = match app::run(node, &mut input, &mut output, packet) {
+        Ok(s) => s,
+        Err(e) => {
+            fail!("processing failed: {:?}", e);
             exit_failure()
         }
-    }
-    figure!("bytes_in", total);
+    };
+    let c = &summary.ingest;
+    figure!("bytes_in", c.bytes_in);
+    figure!("bytes_dropped_full", c.bytes_dropped_full);
+    figure!("bytes_garbage", c.bytes_garbage);
+    figure!("crc_errors", c.crc_errors);
+    figure!("seq_gaps", c.seq_gaps);
+    figure!("points_in", c.points_in);
+    figure!("points_truncated", c.points_truncated);
+    figure!("lines", summary.lines);
+    figure!("configs", summary.configs);
+    figure!("configs_rejected", summary.configs_rejected);
+    figure!("kept", summary.kernel.kept);
+    figure!("irregular", summary.kernel.irregular);
+    figure!("no_neighbour", summary.kernel.no_neighbour);
+    figure!("peaks", summary.kernel.peaks);
+    figure!("packets_out", summary.packets_out);
+    figure!("bytes_out", summary.bytes_out);
+    figure!("ring_bytes", RING);
+    figure!("max_points", MAX_POINTS);
     figure!("stack_size_bytes", stack::size_bytes());
     figure!("stack_high_water_bytes", stack::high_water_mark_bytes());
     drop(output);

@@ -10,6 +10,9 @@
  *                    instruction to the stage that ran last (shared helpers such as
  *                    libm's atan2f or memcpy count for the stage that called them);
  *                    addresses in no range count as "other".
+ *   pcs=FILE         write "PC COUNT" for every executed instruction address in flash
+ *                    (0x08000000..0x08100000) at exit: a flat profile, for finding where
+ *                    a stage spends its instructions (tools/profile.sh).
  * Output (to -D FILE with -d plugin): "insns_total=N insns_in_range=M", then with map= one
  * line "stage NAME N" per stage.
  *
@@ -51,6 +54,12 @@ static char stage_names[MAX_STAGES][64] = { "other" };
 static int n_stages = 1;
 static uint64_t stage_count[MAX_STAGES];
 static int current_stage;       /* the stage that ran last, for "inherit" instructions */
+
+/* Flat profile (pcs=FILE): one counter per halfword of the 1 MiB flash. */
+#define FLASH_LO 0x08000000u
+#define FLASH_HALFWORDS (0x100000u / 2)
+static uint64_t *pc_count;
+static char *pcs_path;
 
 static int stage_id(const char *name) {
     if (!strcmp(name, "inherit")) return INHERIT;
@@ -113,6 +122,9 @@ static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb) {
         uint64_t pc = qemu_plugin_insn_vaddr(insn);
         if (hi && pc >= lo && pc < hi)
             qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64, &region, 1);
+        if (pc_count && pc >= FLASH_LO && pc < FLASH_LO + 2 * (uint64_t)FLASH_HALFWORDS)
+            qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64,
+                                                       &pc_count[(pc - FLASH_LO) / 2], 1);
         if (!ranges) continue;
         int s = stage_of(pc);
         if (s == INHERIT) {
@@ -130,6 +142,16 @@ static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb) {
 static void at_exit(qemu_plugin_id_t id, void *p) {
     (void)id; (void)p;
     char buf[160];
+    if (pc_count) {
+        FILE *f = fopen(pcs_path, "w");
+        if (f) {
+            for (uint32_t i = 0; i < FLASH_HALFWORDS; i++)
+                if (pc_count[i]) fprintf(f, "0x%08x %llu\n", FLASH_LO + 2 * i, (unsigned long long)pc_count[i]);
+            fclose(f);
+        } else {
+            fprintf(stderr, "insncount: cannot write %s\n", pcs_path);
+        }
+    }
     snprintf(buf, sizeof buf, "insns_total=%llu insns_in_range=%llu\n",
              (unsigned long long)total, (unsigned long long)region);
     qemu_plugin_outs(buf);
@@ -148,6 +170,10 @@ int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_t *info, int argc, 
         if (!strncmp(argv[i], "lo=", 3)) lo = strtoull(argv[i] + 3, NULL, 0);
         if (!strncmp(argv[i], "hi=", 3)) hi = strtoull(argv[i] + 3, NULL, 0);
         if (!strncmp(argv[i], "map=", 4)) load_map(argv[i] + 4);
+        if (!strncmp(argv[i], "pcs=", 4)) {
+            pcs_path = strdup(argv[i] + 4);
+            pc_count = calloc(FLASH_HALFWORDS, sizeof *pc_count);
+        }
     }
     qemu_plugin_register_vcpu_tb_trans_cb(id, tb_trans);
     qemu_plugin_register_atexit_cb(id, at_exit, NULL);

@@ -7,7 +7,9 @@
 # measured. STAGES has lines "NAME EXTENDED-REGEX"; for each address the frames are tried
 # from the innermost inlined function outwards, and the first frame matching any stage's
 # regex (tried in file order) names the stage; a frame whose first match is named "skip"
-# is passed over (code shared by two stages, such as the CRC, belongs to its caller). Addresses no stage claims are "other" when
+# is passed over (code shared by two stages belongs to its caller); a frame whose first match
+# is named "+TAG" is passed over too but tags the stage found further out, so shared code
+# can be reported on its own inside each caller (the CRC: "ingest+crc", "output+crc"). Addresses no stage claims are "other" when
 # some frame is the firmware's own code (the loop, semihosting I/O, start-up) and
 # "inherit" otherwise (out-of-line helpers such as libm, memcpy, core::fmt: charged to the
 # stage that called them).
@@ -28,12 +30,14 @@ awk -v s=$((16#$start)) -v n=$((16#$size)) 'BEGIN { for (a = s; a < s + n; a += 
       }
       own = "curbtrace_firmware|cortex_m_rt|cortex_m_semihosting|cortex_m::|^Reset$|HardFault|DefaultHandler|^main$"
     }
-    function classify(   i, k) {
+    function classify(   i, k, tag) {
+      tag = ""
       for (i = 0; i < nf; i++)
         for (k = 0; k < ns; k++)
           if (frame[i] ~ re[k]) {
-            if (name[k] != "skip") return name[k]
-            break
+            if (name[k] == "skip") break
+            if (substr(name[k], 1, 1) == "+") { if (tag == "") tag = name[k]; break }
+            return name[k] tag
           }
       for (i = 0; i < nf; i++) if (frame[i] ~ own) return "other"
       return "inherit"

@@ -1,0 +1,391 @@
+//! The processing loop, the same on the board and in host tests: bytes from a byte link
+//! into the core's ring the way a DMA channel fills it, the kernel on every completed
+//! scanline, each line's output packets out through another byte link.
+//!
+//! The links are `embedded_io::{Read, Write}` (embedded-hal 1.0 has no serial traits), so
+//! a UART, SPI or DMA driver replaces the semihosting files of the QEMU build without this
+//! loop changing.
+//!
+//! [`Node`] is `curbtrace_core::pipeline::Pipeline` taken apart, for two reasons of memory:
+//! `Pipeline::new()` returns its ~80 KiB by value, which passes through the stack (the
+//! firmware's stack is far smaller), while [`Node::init`] builds ingest and kernel in place;
+//! and `pipeline::encode_output` needs a whole line's packets in one buffer (35 KiB for
+//! 2048 points), while [`emit_line`] sends one packet at a time. The per-event logic is
+//! `Pipeline::run`'s and the bytes are `encode_output`'s: `firmware/check.sh` compares the
+//! firmware's output with `curbtrace kernel`, which runs `Pipeline` and `encode_output`.
+
+use core::mem::MaybeUninit;
+use core::ptr::addr_of_mut;
+use curbtrace_core::kernel::{Kernel, KernelCounters, KernelParams, PointStatus, ScanlineOutput};
+use curbtrace_core::scanline::{Ingest, IngestCounters, IngestEvent};
+use curbtrace_core::wire::{
+    EncodeError, OutputHeaderRepr, OutputPointRepr, StreamEncoder, MAX_OUTPUT_POINTS_PER_PACKET,
+    MAX_PACKET_LEN, MAX_POINTS_PER_PACKET, POINTS_PREFIX_LEN, POINT_RECORD_LEN,
+};
+
+use embedded_io::{Read, Write};
+
+/// Largest line the firmware holds: a VQ-250-class line is 2000 pulses.
+pub const MAX_POINTS: usize = 2048;
+
+/// Bytes of one points packet with [`MAX_POINTS_PER_PACKET`] points.
+const FULL_POINTS_PACKET: usize = curbtrace_core::wire::HEADER_LEN
+    + POINTS_PREFIX_LEN
+    + MAX_POINTS_PER_PACKET * POINT_RECORD_LEN
+    + curbtrace_core::wire::CRC_LEN;
+
+/// The ring: one full line of [`MAX_POINTS`] points in packets (the next line keeps
+/// arriving while the kernel works on the last one), plus one packet that may sit in the
+/// ring half-parsed when the line is handed over. 32 × 1304 + 1472 = 43 200 bytes.
+pub const RING: usize =
+    MAX_POINTS.div_ceil(MAX_POINTS_PER_PACKET) * FULL_POINTS_PACKET + MAX_PACKET_LEN;
+
+/// Bytes moved per transfer into the ring (a DMA half-transfer, a `read()` call).
+pub const DMA_CHUNK: usize = 1024;
+
+/// Ingest and kernel: all the working memory of the core, for lines of up to `N` points.
+pub struct Node<const RING: usize, const N: usize> {
+    /// Ring, packet parser, scanline assembly.
+    pub ingest: Ingest<RING, N>,
+    /// The per-scanline kernel.
+    pub kernel: Kernel<N>,
+}
+
+impl<const RING: usize, const N: usize> Node<RING, N> {
+    /// An empty node running the default parameters until the stream's config packet.
+    pub fn new() -> Self {
+        let mut ingest = Ingest::new();
+        ingest.set_split_params(KernelParams::DEFAULT.split_params());
+        Self {
+            ingest,
+            kernel: Kernel::new(KernelParams::DEFAULT),
+        }
+    }
+}
+
+impl<const RING: usize, const N: usize> Node<RING, N> {
+    /// Constructs a node in place at `slot` (the node is ~80 KiB: built by value it would
+    /// pass through the stack, which the firmware keeps small).
+    pub fn init(slot: &mut MaybeUninit<Self>) -> &mut Self {
+        let p = slot.as_mut_ptr();
+        // SAFETY: `p` points to writable, properly aligned memory for a `Self`; both fields
+        // are written before the reference is created, so the node is fully initialised.
+        unsafe {
+            addr_of_mut!((*p).ingest).write(Ingest::new());
+            addr_of_mut!((*p).kernel).write(Kernel::new(KernelParams::DEFAULT));
+            let node = &mut *p;
+            node.ingest
+                .set_split_params(KernelParams::DEFAULT.split_params());
+            node
+        }
+    }
+}
+
+impl<const RING: usize, const N: usize> Default for Node<RING, N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// What a run did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Summary {
+    /// The ingest's counters at the end.
+    pub ingest: IngestCounters,
+    /// Kernel counters summed over all lines.
+    pub kernel: KernelCounters,
+    /// Lines processed.
+    pub lines: u32,
+    /// Config packets applied.
+    pub configs: u32,
+    /// Config packets whose parameters were rejected (the previous ones stayed).
+    pub configs_rejected: u32,
+    /// Output packets written.
+    pub packets_out: u32,
+    /// Output bytes written.
+    pub bytes_out: u64,
+}
+
+/// Why a run stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Error<R, W> {
+    /// The input link failed.
+    Read(R),
+    /// The output link failed.
+    Write(W),
+    /// A line's output could not be encoded (line index, encoder error).
+    Encode(u32, EncodeError),
+    /// The ring had no free space although every complete packet had been taken out
+    /// (cannot happen with `RING` ≥ `MAX_PACKET_LEN`; reported rather than looping).
+    RingStuck,
+}
+
+/// Runs the whole input stream through `node`, writing every line's output packets to
+/// `output`; `packet` is the one output packet buffer.
+pub fn run<R: Read, W: Write, const RING: usize, const N: usize>(
+    node: &mut Node<RING, N>,
+    input: &mut R,
+    output: &mut W,
+    packet: &mut [u8; MAX_PACKET_LEN],
+) -> Result<Summary, Error<R::Error, W::Error>> {
+    let mut sum = Summary::default();
+    let mut enc = StreamEncoder::new();
+    loop {
+        // Fill the ring's free space in place, as a DMA channel would (no copy).
+        let (free, _) = node.ingest.free_slices_mut();
+        let want = free.len().min(DMA_CHUNK);
+        if want == 0 {
+            return Err(Error::RingStuck);
+        }
+        let n = input.read(&mut free[..want]).map_err(Error::Read)?;
+        if n == 0 {
+            break;
+        }
+        node.ingest.commit(n);
+        drain(node, &mut enc, output, packet, &mut sum)?;
+    }
+    node.ingest.finish();
+    drain(node, &mut enc, output, packet, &mut sum)?;
+    output.flush().map_err(Error::Write)?;
+    sum.ingest = node.ingest.counters();
+    Ok(sum)
+}
+
+/// Processes every event the ring holds.
+fn drain<W: Write, E, const RING: usize, const N: usize>(
+    node: &mut Node<RING, N>,
+    enc: &mut StreamEncoder,
+    output: &mut W,
+    packet: &mut [u8; MAX_PACKET_LEN],
+    sum: &mut Summary,
+) -> Result<(), Error<E, W::Error>> {
+    while let Some(event) = node.ingest.poll() {
+        match event {
+            IngestEvent::Config(words) => {
+                // As Pipeline::run: kernel and assembler from the next line on; a bad block
+                // is counted and the old parameters stay.
+                match KernelParams::from_words(&words)
+                    .and_then(|p| node.kernel.set_params(p).map(|()| p))
+                {
+                    Ok(p) => {
+                        node.ingest.set_split_params(p.split_params());
+                        sum.configs += 1;
+                    }
+                    Err(_) => sum.configs_rejected += 1,
+                }
+            }
+            IngestEvent::Line(line) => {
+                let out = node.kernel.process(line);
+                add_counters(&mut sum.kernel, &out.counters);
+                sum.lines += 1;
+                emit_line(&out, enc, packet, output, sum)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+fn add_counters(total: &mut KernelCounters, c: &KernelCounters) {
+    total.points_in += c.points_in;
+    total.kept += c.kept;
+    total.irregular += c.irregular;
+    total.no_neighbour += c.no_neighbour;
+    total.non_finite += c.non_finite;
+    total.peaks += c.peaks;
+    total.capped_windows += c.capped_windows;
+    total.smooth_pieces += c.smooth_pieces;
+}
+
+/// The wire header of a line's output, as `pipeline::encode_output` builds it (counters
+/// above 65 535 saturate; they cannot reach that with 2048-point lines).
+pub fn output_header(out: &ScanlineOutput<'_>) -> Result<OutputHeaderRepr, EncodeError> {
+    let sat = |v: u32| u16::try_from(v).unwrap_or(u16::MAX);
+    let n = out.status.len();
+    Ok(OutputHeaderRepr {
+        index: out.index,
+        start_time_ns: out.start_time_ns,
+        params_hash: out.params_hash,
+        truncated: out.truncated,
+        line_len: u16::try_from(n).map_err(|_| EncodeError::TooManyPoints {
+            count: n,
+            max: usize::from(u16::MAX),
+        })?,
+        first: 0,
+        nadir: out.nadir,
+        left: out.left,
+        right: out.right,
+        kept: sat(out.counters.kept),
+        irregular: sat(out.counters.irregular),
+        no_neighbour: sat(out.counters.no_neighbour),
+        peaks: sat(out.counters.peaks),
+    })
+}
+
+/// Output point `i` of a line, as `pipeline::encode_output` converts it (a non-finite point
+/// goes out at x′ = z′ = 0 with its status).
+pub fn output_point(out: &ScanlineOutput<'_>, i: usize) -> Result<OutputPointRepr, EncodeError> {
+    let status = *out
+        .status
+        .get(i)
+        .ok_or(EncodeError::OutOfRange { index: i })?;
+    let get = |s: &[f32]| s.get(i).copied().unwrap_or(0.0);
+    let (x, z) = if status == PointStatus::NonFinite {
+        (0.0, 0.0)
+    } else {
+        (get(out.x_m), get(out.z_m))
+    };
+    let tag = out.tag.get(i).copied().unwrap_or(0);
+    OutputPointRepr::from_f32(tag, x, z, get(out.rho_deg), status as u8, i)
+}
+
+/// Writes one line's output packets, one packet buffer at a time (a whole 2048-point line
+/// would need 34 KiB at once).
+fn emit_line<W: Write, E>(
+    out: &ScanlineOutput<'_>,
+    enc: &mut StreamEncoder,
+    packet: &mut [u8; MAX_PACKET_LEN],
+    output: &mut W,
+    sum: &mut Summary,
+) -> Result<(), Error<E, W::Error>> {
+    let header = output_header(out).map_err(|e| Error::Encode(out.index, e))?;
+    let point = |i: usize| output_point(out, i);
+    for k in 0..header.fragments() {
+        let first = u16::try_from(k * MAX_OUTPUT_POINTS_PER_PACKET)
+            .map_err(|_| Error::Encode(out.index, EncodeError::OutOfRange { index: k }))?;
+        let n = enc
+            .encode_output_fragment(&header, first, point, packet)
+            .map_err(|e| Error::Encode(out.index, e))?;
+        output.write_all(&packet[..n]).map_err(Error::Write)?;
+        sum.packets_out += 1;
+        sum.bytes_out += n as u64;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use curbtrace_core::wire::{OutputHeaderRepr, Packet, PointRecord, CONFIG_WORDS};
+
+    /// A reader that hands out at most `step` bytes per call (a slow link).
+    struct Trickle<'a> {
+        data: &'a [u8],
+        step: usize,
+    }
+    impl embedded_io::ErrorType for Trickle<'_> {
+        type Error = core::convert::Infallible;
+    }
+    impl Read for Trickle<'_> {
+        fn read(&mut self, buf: &mut [u8]) -> Result<usize, Self::Error> {
+            let n = self.step.min(buf.len()).min(self.data.len());
+            buf[..n].copy_from_slice(&self.data[..n]);
+            self.data = &self.data[n..];
+            Ok(n)
+        }
+    }
+    struct Sink(Vec<u8>);
+    impl embedded_io::ErrorType for Sink {
+        type Error = core::convert::Infallible;
+    }
+    impl Write for Sink {
+        fn write(&mut self, buf: &[u8]) -> Result<usize, Self::Error> {
+            self.0.extend_from_slice(buf);
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> Result<(), Self::Error> {
+            Ok(())
+        }
+    }
+
+    /// A config packet, then `lines` lines of `n` points on a V-shaped profile (a bend at
+    /// the nadir), each line starting with the line-start flag.
+    fn stream(config: &[u32; CONFIG_WORDS], lines: usize, n: usize) -> Vec<u8> {
+        let mut enc = StreamEncoder::new();
+        let mut out = Vec::new();
+        let mut buf = [0u8; MAX_PACKET_LEN];
+        let k = enc.encode_config(config, &mut buf).unwrap();
+        out.extend_from_slice(&buf[..k]);
+        let mut tag = 0;
+        for l in 0..lines {
+            let pts: Vec<PointRecord> = (0..n)
+                .map(|i| {
+                    let x = -2.0 + 4.0 * i as f32 / n as f32;
+                    tag += 1;
+                    PointRecord {
+                        dt_ns: i as u32 * 1000,
+                        x_m: x,
+                        z_m: -2.0 + 0.1 * x.abs(),
+                        intensity: 0,
+                        line_start: i == 0,
+                        tag,
+                    }
+                })
+                .collect();
+            for (c, chunk) in pts.chunks(MAX_POINTS_PER_PACKET).enumerate() {
+                let base =
+                    1_000_000_000 * (l as u64 + 1) + (c * MAX_POINTS_PER_PACKET) as u64 * 1000;
+                let k = enc.encode_points(base, chunk, &mut buf).unwrap();
+                out.extend_from_slice(&buf[..k]);
+            }
+        }
+        out
+    }
+
+    fn run_all(input: &[u8], step: usize) -> (Summary, Vec<u8>) {
+        let mut node: Box<Node<RING, 512>> = Box::default();
+        let mut packet = [0u8; MAX_PACKET_LEN];
+        let mut out = Sink(Vec::new());
+        let sum = run(
+            &mut node,
+            &mut Trickle { data: input, step },
+            &mut out,
+            &mut packet,
+        )
+        .expect("runs");
+        (sum, out.0)
+    }
+
+    #[test]
+    fn chunking_does_not_change_the_output() {
+        let input = stream(&KernelParams::DEFAULT.to_words(), 3, 300);
+        let (sum, whole) = run_all(&input, usize::MAX);
+        assert_eq!(sum.lines, 3);
+        assert_eq!(sum.configs, 1);
+        assert_eq!(sum.ingest.points_in, 900);
+        assert_eq!(sum.ingest.bytes_dropped_full, 0);
+        // 300 points = 4 output packets of ≤ 88 points ((1472 − 56) / 16) per line.
+        assert_eq!(MAX_OUTPUT_POINTS_PER_PACKET, 88);
+        assert_eq!(sum.packets_out, 12);
+        assert_eq!(sum.bytes_out, whole.len() as u64);
+        for step in [1, 7, 1000] {
+            let (s, out) = run_all(&input, step);
+            assert_eq!(out, whole, "step {step}");
+            assert_eq!(s.lines, 3);
+        }
+        // Every packet is a valid output packet of a line with the nadir at its V.
+        let mut at = 0;
+        while at < whole.len() {
+            let p = Packet::new_checked(&whole[at..]).unwrap();
+            let len = p.length();
+            let p = Packet::new_unchecked(&whole[at..at + len]);
+            let (h, _) = OutputHeaderRepr::parse(&p).unwrap();
+            assert_eq!(h.line_len, 300);
+            assert!(
+                h.nadir.is_some_and(|i| (145..=155).contains(&i)),
+                "{:?}",
+                h.nadir
+            );
+            at += len;
+        }
+    }
+
+    #[test]
+    fn a_bad_config_is_counted_and_the_defaults_stay() {
+        let mut words = KernelParams::DEFAULT.to_words();
+        words[0] = f32::NAN.to_bits(); // d_b
+        let (sum, _) = run_all(&stream(&words, 1, 100), 64);
+        assert_eq!(sum.configs, 0);
+        assert_eq!(sum.configs_rejected, 1);
+        assert_eq!(sum.lines, 1);
+    }
+}
