@@ -96,9 +96,9 @@ fn main() -> anyhow::Result<()> {
     for s in &report.sections {
         let sec = s.section.expect("set");
         println!(
-            "  section {} [{:.0}, {:.0}] m: {} points in, {} after §3.2, β = {:?}, {} candidates, width {:?}, {} kept by width, {} chains",
+            "  section {} [{:.0}, {:.0}] m: {} points in, {} after §3.2, β = {:?}, {} candidates, width {:?}, {} kept by width, {} chains; stage seconds {:.2?}",
             sec.index, sec.s_start, sec.s_end, s.points_in, s.points_preprocessed, s.beta_m,
-            s.candidates, s.road_width_m, s.width_kept, s.chains
+            s.candidates, s.road_width_m, s.width_kept, s.chains, s.stage_s
         );
         if std::env::var("QIU_VERBOSE").is_ok() {
             println!("    energies {:?}", s.energies);
@@ -113,7 +113,11 @@ fn main() -> anyhow::Result<()> {
                 ..EvalParams::default()
             },
         )?;
-        println!("\n### buffer {:.0} mm\n\n{}", buffer * 1e3, ev.to_markdown());
+        println!(
+            "\n### buffer {:.0} mm\n\n{}",
+            buffer * 1e3,
+            ev.to_markdown()
+        );
     }
     if let Some(dir) = out {
         std::fs::create_dir_all(&dir)?;

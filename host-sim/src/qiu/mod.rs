@@ -69,6 +69,9 @@ pub struct SectionReport {
     pub width_kept: usize,
     /// Chains kept by the continuity refinement (before clipping to the core).
     pub chains: usize,
+    /// Wall seconds per stage: partition (§3.1), pre-processing (§3.2), normalisation
+    /// (§3.3.1), rough segmentation (§3.3.2), refinement and heights (§3.4).
+    pub stage_s: [f64; 5],
 }
 
 /// What happened overall.
@@ -182,6 +185,11 @@ fn process_section(
         return (Vec::new(), rep);
     };
     let o = [origin.x, origin.y, origin.z];
+    let mut clock = std::time::Instant::now();
+    let mut lap = |k: usize, rep: &mut SectionReport| {
+        rep.stage_s[k] = clock.elapsed().as_secs_f64();
+        clock = std::time::Instant::now();
+    };
     // §3.1: the section's GPS time interval, then its width across the trajectory.
     let lo = times.partition_point(|&t| t < sec.t_start);
     let hi = times.partition_point(|&t| t <= sec.t_end);
@@ -196,6 +204,7 @@ fn process_section(
         })
         .collect();
     rep.points_in = raw.len();
+    lap(0, &mut rep);
     // §3.2.
     let pts = if params.sor_after_voxel {
         let v = preprocess::voxel_downsample(&raw, params.voxel_m);
@@ -206,6 +215,7 @@ fn process_section(
     };
     drop(raw);
     rep.points_preprocessed = pts.len();
+    lap(1, &mut rep);
     // §3.3.1.
     let norm = normalise::normalise_to_grid_min(&pts, params.grid_cell_m);
     let pts_norm: Vec<[f64; 3]> = pts
@@ -213,6 +223,7 @@ fn process_section(
         .zip(&norm.z_norm)
         .map(|(p, &z)| [p[0], p[1], z])
         .collect();
+    lap(2, &mut rep);
     // §3.3.2.
     let track = SectionTrack::new(traj, st, sec.t_start - TRACK_PAD_S, sec.t_end + TRACK_PAD_S);
     let locate = |i: usize| track.locate(pts[i][0] + o[0], pts[i][1] + o[1]);
@@ -231,6 +242,7 @@ fn process_section(
     rep.beta_m = seg.beta_m;
     rep.energies = seg.energies.clone();
     rep.candidates = seg.candidates.len();
+    lap(3, &mut rep);
     let edge_pts: Vec<EdgePoint> = seg
         .candidates
         .iter()
@@ -258,6 +270,7 @@ fn process_section(
         .iter()
         .flat_map(|c| refine::clip_to_stations(c, sec.core_start, sec.core_end))
         .collect();
+    lap(4, &mut rep);
     (clipped, rep)
 }
 
