@@ -140,9 +140,7 @@ pub fn extract_edges_with_report(
     let lines = chains
         .into_iter()
         .map(|c| {
-            let mut hs: Vec<f64> = c.h.iter().copied().filter(|h| h.is_finite()).collect();
-            hs.sort_unstable_by(f64::total_cmp);
-            let curb_height_m = (!hs.is_empty()).then(|| hs[hs.len() / 2]);
+            let curb_height_m = refine::median_step(&c);
             let category = curb_height_m.and_then(|h| {
                 if h >= 0.05 {
                     Some(Category::Curb)
@@ -261,11 +259,14 @@ fn process_section(
     rep.road_width_m = width.road_width_m;
     rep.width_kept = width.kept.len();
     let mut chains = refine::refine_by_continuity(&edge_pts, &width.kept, params);
-    rep.chains = chains.len();
     let grid = HeightGrid::new(&pts, o);
     for c in &mut chains {
         grid.measure_steps(c, params.height_band_m);
     }
+    // Ground on both sides (see `QiuParams::min_step_m`), then §3.4.2 step 4.
+    chains.retain(|c| refine::median_step(c).is_some_and(|h| h >= params.min_step_m));
+    let chains = refine::keep_longest(chains, params);
+    rep.chains = chains.len();
     let clipped: Vec<Chain> = chains
         .iter()
         .flat_map(|c| refine::clip_to_stations(c, sec.core_start, sec.core_end))

@@ -225,9 +225,9 @@ pub struct Segmentation {
 /// §3.3.2 as a whole on normalised points (`pts` with z replaced by height above the grid
 /// minimum). `position_of(i)` gives the station and signed offset of point `i` relative to
 /// its nearest trajectory point. Among sets with at least `min_candidates` points, the
-/// smallest β whose E_s is within `energy_tolerance` (relative, plus 0.01 m² absolute) of
-/// the smallest E_s wins: equally smooth sets differ only in how low a step they still
-/// see, and the smaller β sees lower curbs.
+/// smallest β whose E_s is within `energy_tolerance` (relative) of the smallest E_s wins
+/// (with the default 0, the set with the smallest E_s as in the paper; ties go to the
+/// smaller β, which sees lower curbs).
 #[allow(clippy::too_many_arguments)]
 pub fn rough_segmentation(
     pts: &[[f64; 3]],
@@ -275,7 +275,7 @@ pub fn rough_segmentation(
     let Some(e_min) = sets.iter().map(|s| s.0).min_by(f64::total_cmp) else {
         return out;
     };
-    let limit = e_min * (1.0 + energy_tolerance) + 0.01;
+    let limit = e_min * (1.0 + energy_tolerance);
     if let Some((_, beta, cand)) = sets
         .into_iter()
         .filter(|s| s.0 <= limit)
