@@ -106,8 +106,10 @@ pub struct TopView<'a> {
     /// At most about this many points are drawn (an even random-looking subsample of those
     /// in view, the same on every run).
     pub max_points: usize,
-    /// Height range of the colour scale, metres; `None`: from the 2nd percentile of the
-    /// heights in view up to the 98th, at most [`AUTO_Z_SPAN_M`] above it.
+    /// What the colour shows.
+    pub colouring: Colouring,
+    /// Range of the colour scale, metres; `None`: from the 2nd percentile of the values in
+    /// view up to the 98th, at most [`AUTO_Z_SPAN_M`] above it.
     pub z_range_m: Option<(f64, f64)>,
     /// Width of the PNG in pixels (the height follows from the view's shape).
     pub width_px: u32,
@@ -129,10 +131,66 @@ impl<'a> TopView<'a> {
             trajectory: &[],
             window: None,
             max_points: 400_000,
+            colouring: Colouring::AboveLocalGround,
             z_range_m: None,
             width_px: 1600,
         }
     }
+}
+
+/// What the colour of a point shows in a top view.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Colouring {
+    /// Its height z.
+    Height,
+    /// Its height above the local ground: z minus the lowest 5th-percentile height of the
+    /// 2 m cells within ±5 m. A road's grade then no longer swamps the colour scale, and
+    /// road, curb and sidewalk read the same everywhere along a long street.
+    AboveLocalGround,
+}
+
+/// Ground cells of [`Colouring::AboveLocalGround`], metres.
+const GROUND_CELL_M: f64 = 2.0;
+/// Neighbourhood of [`Colouring::AboveLocalGround`], in cells each way (±5 m with 2 m cells,
+/// wide enough that a sidewalk cell sees the road beside it).
+const GROUND_REACH: i64 = 2;
+
+/// Heights above the local ground for the points `idx` (see [`Colouring::AboveLocalGround`]).
+fn above_local_ground(c: &Cloud, idx: &[usize]) -> Vec<f64> {
+    use std::collections::HashMap;
+    let key = |i: usize| {
+        (
+            (c.x[i] / GROUND_CELL_M).floor() as i64,
+            (c.y[i] / GROUND_CELL_M).floor() as i64,
+        )
+    };
+    let mut cells: HashMap<(i64, i64), Vec<f64>> = HashMap::new();
+    for &i in idx {
+        cells.entry(key(i)).or_default().push(c.z[i]);
+    }
+    // The 5th percentile, not the minimum: a few low outliers must not sink a cell.
+    let low: HashMap<(i64, i64), f64> = cells
+        .into_iter()
+        .map(|(k, mut v)| (k, quantile(&mut v, 0.05)))
+        .collect();
+    let mut ground: HashMap<(i64, i64), f64> = HashMap::new();
+    idx.iter()
+        .map(|&i| {
+            let k = key(i);
+            let g = *ground.entry(k).or_insert_with(|| {
+                let mut g = f64::INFINITY;
+                for dx in -GROUND_REACH..=GROUND_REACH {
+                    for dy in -GROUND_REACH..=GROUND_REACH {
+                        if let Some(&l) = low.get(&(k.0 + dx, k.1 + dy)) {
+                            g = g.min(l);
+                        }
+                    }
+                }
+                g
+            });
+            c.z[i] - g
+        })
+        .collect()
 }
 
 /// What [`top_view_png`] did, for logs and tests.
@@ -144,14 +202,14 @@ pub struct TopViewStats {
     pub points_drawn: usize,
     /// Picture size in pixels.
     pub size_px: (u32, u32),
-    /// Height range of the colour scale, metres.
+    /// Range of the colour scale, metres.
     pub z_range_m: (f64, f64),
 }
 
 /// The automatic colour scale spans at most this much height above its low end (the 2nd
 /// percentile), metres: curbs (0.02–0.2 m) must stay visible beside walls and cars several
 /// metres high, which saturate at the top colour.
-pub const AUTO_Z_SPAN_M: f64 = 0.8;
+pub const AUTO_Z_SPAN_M: f64 = 0.5;
 
 /// SplitMix64's output function: a well-mixed hash of `x`.
 fn splitmix64(x: u64) -> u64 {
@@ -337,6 +395,134 @@ fn dashes(pts: &[(f64, f64)], dash: f64) -> Vec<Vec<(f64, f64)>> {
     out
 }
 
+/// The point at half the 2D length of a polyline (its first vertex if it has no length).
+fn mid_point(l: &EdgeLine) -> Option<[f64; 2]> {
+    let half = l.length_m() / 2.0;
+    let mut s = 0.0;
+    for w in l.points.windows(2) {
+        let len = (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]);
+        if s + len >= half && len > 0.0 {
+            let t = (half - s) / len;
+            return Some([
+                w[0][0] + t * (w[1][0] - w[0][0]),
+                w[0][1] + t * (w[1][1] - w[0][1]),
+            ]);
+        }
+        s += len;
+    }
+    l.points.first().map(|p| [p[0], p[1]])
+}
+
+/// Unit direction of a line at one end, pointing out of the line (`at_end`: the last
+/// vertex, else the first), from the end vertex and the vertex about 1 m inside.
+fn end_direction(l: &EdgeLine, at_end: bool) -> Option<[f64; 2]> {
+    let pts: Vec<&[f64; 3]> = if at_end {
+        l.points.iter().rev().collect()
+    } else {
+        l.points.iter().collect()
+    };
+    let e = pts.first()?;
+    let inner = pts
+        .iter()
+        .find(|p| (p[0] - e[0]).hypot(p[1] - e[1]) >= 1.0)
+        .or(pts.last())?;
+    let (dx, dy) = (e[0] - inner[0], e[1] - inner[1]);
+    let n = dx.hypot(dy);
+    (n > 0.0).then(|| [dx / n, dy / n])
+}
+
+/// Zoom windows at the places people want to see, found from the reference lines:
+/// the longest curb cut, intersection and bus bay (centred on the middle of the line) and the
+/// longest *occlusion*: a hole of 2–15 m between two free ends (meeting no other line of
+/// their side) of curb or curb-cut lines of one side that continue each other straight
+/// (within 20°), which is where the reference leaves out what the
+/// scanner never saw — usually a parked car. Returns (name, window) pairs; names are
+/// `curb_cut`, `intersection`, `bus_bay`, `occlusion`.
+pub fn windows_of_interest(reference: &[EdgeLine], half_size_m: f64) -> Vec<(String, Window)> {
+    use crate::model::Category;
+    let mut out = Vec::new();
+    for cat in [Category::CurbCut, Category::Intersection, Category::BusBay] {
+        // The longest line of the category shows it best.
+        let best = reference
+            .iter()
+            .filter(|l| l.category == Some(cat))
+            .max_by(|a, b| a.length_m().total_cmp(&b.length_m()));
+        if let Some(c) = best.and_then(mid_point) {
+            out.push((
+                cat.as_str().to_string(),
+                Window {
+                    center: c,
+                    half_size_m,
+                },
+            ));
+        }
+    }
+    let straight = |l: &&EdgeLine| matches!(l.category, Some(Category::Curb | Category::CurbCut));
+    let ends: Vec<(usize, [f64; 2], [f64; 2])> = reference
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| straight(l))
+        .flat_map(|(i, l)| {
+            [false, true].into_iter().filter_map(move |at_end| {
+                let p = if at_end {
+                    l.points.last()
+                } else {
+                    l.points.first()
+                }?;
+                Some((i, [p[0], p[1]], end_direction(l, at_end)?))
+            })
+        })
+        .collect();
+    // An end that meets another line of its side (a curb running on as a curb cut) is no
+    // hole.
+    let meets_another = |i: usize, p: [f64; 2]| {
+        reference.iter().enumerate().any(|(j, l)| {
+            j != i
+                && l.side == reference[i].side
+                && [l.points.first(), l.points.last()]
+                    .into_iter()
+                    .flatten()
+                    .any(|q| (q[0] - p[0]).hypot(q[1] - p[1]) < 0.5)
+        })
+    };
+    let ends: Vec<_> = ends
+        .into_iter()
+        .filter(|&(i, p, _)| !meets_another(i, p))
+        .collect();
+    let cos20 = 20f64.to_radians().cos();
+    let mut hole: Option<(f64, [f64; 2])> = None;
+    for (a, &(ia, pa, da)) in ends.iter().enumerate() {
+        for &(ib, pb, db) in &ends[a + 1..] {
+            if ia == ib || reference[ia].side != reference[ib].side {
+                continue;
+            }
+            let (dx, dy) = (pb[0] - pa[0], pb[1] - pa[1]);
+            let gap = dx.hypot(dy);
+            if !(2.0..=15.0).contains(&gap) {
+                continue;
+            }
+            let (ux, uy) = (dx / gap, dy / gap);
+            // a's end points towards b, b's end points back towards a.
+            if da[0] * ux + da[1] * uy >= cos20
+                && -(db[0] * ux + db[1] * uy) >= cos20
+                && hole.is_none_or(|(g, _)| gap > g)
+            {
+                hole = Some((gap, [pa[0] + dx / 2.0, pa[1] + dy / 2.0]));
+            }
+        }
+    }
+    if let Some((_, c)) = hole {
+        out.push((
+            "occlusion".to_string(),
+            Window {
+                center: c,
+                half_size_m,
+            },
+        ));
+    }
+    out
+}
+
 /// Draws a top view of `view` into the PNG `path` and returns what it drew.
 ///
 /// The picture has equal scale on both axes; its height follows from the view's shape
@@ -423,35 +609,52 @@ pub fn top_view_png(path: &Path, view: &TopView) -> Result<TopViewStats, PlotErr
     } else {
         u64::MAX
     };
-    let mut drawn: Vec<usize> = in_view
+    let drawn: Vec<usize> = in_view
         .iter()
         .copied()
         .filter(|&i| splitmix64(i as u64) <= keep)
         .collect();
+    // Colour values, indexed like `drawn`; drawn lowest first.
+    let values: Vec<f64> = match view.colouring {
+        Colouring::Height => drawn.iter().map(|&i| c.z[i]).collect(),
+        Colouring::AboveLocalGround => above_local_ground(&c, &drawn),
+    };
     let z_range = match view.z_range_m {
         Some(r) if r.0.is_finite() && r.1.is_finite() && r.1 > r.0 => r,
         _ if drawn.is_empty() => (0.0, 1.0),
         _ => {
-            let mut zs: Vec<f64> = drawn.iter().map(|&i| c.z[i]).collect();
+            let mut zs = values.clone();
             let lo = quantile(&mut zs, 0.02);
             let hi = quantile(&mut zs, 0.98).min(lo + AUTO_Z_SPAN_M);
             (lo, if hi > lo { hi } else { lo + 0.1 })
         }
     };
-    drawn.sort_unstable_by(|&a, &b| c.z[a].total_cmp(&c.z[b]));
+    let mut order: Vec<usize> = (0..drawn.len()).collect();
+    order.sort_unstable_by(|&a, &b| values[a].total_cmp(&values[b]));
 
     // Local axes from a round origin.
     let ox = round_origin(x0, dx);
     let oy = round_origin(y0, dy);
     let (lx0, lx1, ly0, ly1) = (x0 - ox, x1 - ox, y0 - oy, y1 - oy);
     let px_per_m = plot_w / (lx1 - lx0);
-    // Marker size from the spacing of the drawn points on screen.
+    // Marker size from the spacing of the drawn points on screen, over the area they
+    // cover (8 px cells holding a point), not the whole plot: a street is a thin band.
+    let covered_px = {
+        let mut cells = std::collections::HashSet::new();
+        for &i in &drawn {
+            cells.insert((
+                ((c.x[i] - x0) * px_per_m / 8.0) as i64,
+                ((c.y[i] - y0) * px_per_m / 8.0) as i64,
+            ));
+        }
+        cells.len() as f64 * 64.0
+    };
     let spacing_px = if drawn.is_empty() {
         1.0
     } else {
-        (plot_w * plot_h / drawn.len() as f64).sqrt()
+        (covered_px / drawn.len() as f64).sqrt()
     };
-    let radius = (spacing_px * 0.45).clamp(1.0, 4.0).round() as i32;
+    let radius = (spacing_px * 0.6).clamp(1.0, 4.0).round() as i32;
 
     let err = draw_err(path);
     let root = BitMapBackend::new(path, (w_px, h_px)).into_drawing_area();
@@ -479,8 +682,9 @@ pub fn top_view_png(path: &Path, view: &TopView) -> Result<TopViewStats, PlotErr
 
     let (zlo, zhi) = z_range;
     chart
-        .draw_series(drawn.iter().map(|&i| {
-            let col = viridis((c.z[i] - zlo) / (zhi - zlo));
+        .draw_series(order.iter().map(|&k| {
+            let i = drawn[k];
+            let col = viridis((values[k] - zlo) / (zhi - zlo));
             Circle::new((c.x[i] - ox, c.y[i] - oy), radius, col.filled())
         }))
         .map_err(&err)?;
@@ -559,7 +763,11 @@ pub fn top_view_png(path: &Path, view: &TopView) -> Result<TopViewStats, PlotErr
         .draw()
         .map_err(&err)?;
 
-    draw_colour_bar(&bar, z_range, TOP + MARGIN, BOTTOM + MARGIN).map_err(&err)?;
+    let bar_title = match view.colouring {
+        Colouring::Height => "height [m]",
+        Colouring::AboveLocalGround => "height above local ground [m]",
+    };
+    draw_colour_bar(&bar, z_range, bar_title, TOP + MARGIN, BOTTOM + MARGIN).map_err(&err)?;
     root.present().map_err(&err)?;
     Ok(TopViewStats {
         points_in_view: in_view.len(),
@@ -625,6 +833,7 @@ fn scene_extent(view: &TopView) -> Option<(f64, f64, f64, f64)> {
 fn draw_colour_bar(
     area: &DrawingArea<BitMapBackend, Shift>,
     z_range: (f64, f64),
+    title: &str,
     top: u32,
     bottom: u32,
 ) -> Result<(), DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>> {
@@ -640,7 +849,7 @@ fn draw_colour_bar(
         .disable_x_axis()
         .disable_x_mesh()
         .disable_y_mesh()
-        .y_desc("height [m]")
+        .y_desc(title)
         .y_labels(8)
         .y_label_formatter(&|v| tick(*v, zhi - zlo))
         .label_style((FONT_NAME, 14))
@@ -946,6 +1155,77 @@ mod tests {
     }
 
     #[test]
+    fn windows_of_interest_find_categories_and_the_occlusion() {
+        let l = |pts: &[(f64, f64)], side, cat| EdgeLine {
+            points: pts.iter().map(|&(x, y)| [x, y, 0.0]).collect(),
+            side,
+            category: Some(cat),
+            method: None,
+            curb_height_m: None,
+        };
+        let refs = vec![
+            l(&[(0.0, 5.0), (40.0, 5.0)], Side::Left, Category::Curb),
+            // A 6 m hole (parked car), then the curb goes on straight.
+            l(&[(46.0, 5.0), (60.0, 5.0)], Side::Left, Category::Curb),
+            l(&[(60.0, 5.0), (66.0, 5.0)], Side::Left, Category::CurbCut),
+            // An intersection corner turning away: its 10 m hole to the next curb is not
+            // straight, so it is no occlusion.
+            l(
+                &[(66.0, 5.0), (70.0, 9.0)],
+                Side::Left,
+                Category::Intersection,
+            ),
+            l(
+                &[(80.0, 9.0), (84.0, 5.0), (120.0, 5.0)],
+                Side::Left,
+                Category::Curb,
+            ),
+            l(&[(0.0, -5.0), (20.0, -5.0)], Side::Right, Category::Curb),
+            l(&[(20.0, -5.0), (40.0, -7.0)], Side::Right, Category::BusBay),
+        ];
+        let w = windows_of_interest(&refs, 8.0);
+        let names: Vec<&str> = w.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["curb_cut", "intersection", "bus_bay", "occlusion"]);
+        assert_eq!(w[0].1.center, [63.0, 5.0]);
+        assert_eq!(w[3].1.center, [43.0, 5.0]);
+        assert!((w[2].1.center[0] - 30.0).abs() < 1e-9);
+        assert_eq!(w[3].1.half_size_m, 8.0);
+        assert!(windows_of_interest(&refs[..1], 8.0).is_empty());
+    }
+
+    #[test]
+    fn height_above_local_ground_removes_the_grade() {
+        // A road rising 5 % eastwards over 100 m, 8 m wide, with 0.15 m sidewalks 3 m wide.
+        let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..500 {
+            for j in 0..70 {
+                let (px, py) = (i as f64 * 0.2, -7.0 + j as f64 * 0.2);
+                x.push(1000.0 + px);
+                y.push(2000.0 + py);
+                z.push(50.0 + 0.05 * px + if py.abs() > 4.0 { 0.15 } else { 0.0 });
+            }
+        }
+        let c = Cloud {
+            x: &x,
+            y: &y,
+            z: &z,
+        };
+        let idx: Vec<usize> = (0..x.len()).collect();
+        let h = above_local_ground(&c, &idx);
+        // The lowest cell within ±5 m lies up to 2 cells (4 m + a cell) downhill: at most
+        // 0.05 × 6 m = 0.3 m; the step between road and sidewalk stays 0.15 m everywhere.
+        for i in (0..x.len()).step_by(997) {
+            let road = (y[i] - 2000.0).abs() <= 4.0;
+            assert!(h[i] >= -1e-9 && h[i] <= 0.3 + if road { 0.0 } else { 0.15 } + 1e-9);
+        }
+        // Same place along the road, road and sidewalk: differ by the curb.
+        let at = |px: usize, py: usize| h[px * 70 + py];
+        assert!((at(250, 60) - at(250, 40) - 0.15).abs() < 1e-9);
+        // And the values do not grow along the road as z does (25 m apart: 1.25 m in z).
+        assert!((at(300, 40) - at(175, 40)).abs() < 0.1);
+    }
+
+    #[test]
     fn clipping_keeps_only_what_is_inside() {
         let r = (0.0, 10.0, 0.0, 10.0);
         // Entirely outside (below): nothing, not a line along the border.
@@ -1025,6 +1305,7 @@ mod tests {
         );
         v.trajectory = &traj;
         v.max_points = 20_000;
+        v.colouring = Colouring::Height;
         let p = dir.join("top.png");
         let s = top_view_png(&p, &v).unwrap();
         assert_eq!(s.points_in_view, xs.len());

@@ -185,36 +185,51 @@ pub fn height_steps(
         .collect();
     let (g, w) = (params.step_gap_m, params.step_strip_m);
     let along_max = 0.15;
-    (0..xy.len())
-        .map(|k| {
-            let tan = tangent(&xy, k, 0.3)?;
-            let mut nrm = [-tan[1], tan[0]];
-            let (q, _) = route.nearest(xy[k][0], xy[k][1])?;
-            if nrm[0] * (xy[k][0] - q[0]) + nrm[1] * (xy[k][1] - q[1]) < 0.0 {
-                nrm = [-nrm[0], -nrm[1]];
+    let step_at = |k: usize| -> Option<f64> {
+        let tan = tangent(&xy, k, 0.3)?;
+        let mut nrm = [-tan[1], tan[0]];
+        let (q, _) = route.nearest(xy[k][0], xy[k][1])?;
+        if nrm[0] * (xy[k][0] - q[0]) + nrm[1] * (xy[k][1] - q[1]) < 0.0 {
+            nrm = [-nrm[0], -nrm[1]];
+        }
+        let mut inner = Vec::new();
+        let mut outer = Vec::new();
+        let r = (g + w).hypot(along_max);
+        grid.for_each_within(input.x, input.y, xy[k][0], xy[k][1], r, |i| {
+            if input.status[i] == STATUS_NOT_PROCESSED {
+                return;
             }
-            let mut inner = Vec::new();
-            let mut outer = Vec::new();
-            let r = (g + w).hypot(along_max);
-            grid.for_each_within(input.x, input.y, xy[k][0], xy[k][1], r, |i| {
-                if input.status[i] == STATUS_NOT_PROCESSED {
-                    return;
-                }
-                let d = [input.x[i] - xy[k][0], input.y[i] - xy[k][1]];
-                let along = d[0] * tan[0] + d[1] * tan[1];
-                let across = d[0] * nrm[0] + d[1] * nrm[1];
-                if along.abs() > along_max {
-                    return;
-                }
-                if across >= g && across <= g + w {
-                    outer.push(input.z[i]);
-                } else if across <= -g && across >= -g - w {
-                    inner.push(input.z[i]);
-                }
-            });
-            Some(median(&mut outer)? - median(&mut inner)?)
-        })
-        .collect()
+            let d = [input.x[i] - xy[k][0], input.y[i] - xy[k][1]];
+            let along = d[0] * tan[0] + d[1] * tan[1];
+            let across = d[0] * nrm[0] + d[1] * nrm[1];
+            if along.abs() > along_max {
+                return;
+            }
+            if across >= g && across <= g + w {
+                outer.push(input.z[i]);
+            } else if across <= -g && across >= -g - w {
+                inner.push(input.z[i]);
+            }
+        });
+        Some(median(&mut outer)? - median(&mut inner)?)
+    };
+    // Measured every STEP_SPACING_M along the edge (the strips are 0.3 m long, so closer
+    // samples would mostly repeat each other); vertices in between take the last value.
+    const STEP_SPACING_M: f64 = 0.25;
+    let mut out = Vec::with_capacity(xy.len());
+    let mut last: Option<f64> = None;
+    let mut since = f64::INFINITY;
+    for k in 0..xy.len() {
+        if k > 0 {
+            since += (xy[k][0] - xy[k - 1][0]).hypot(xy[k][1] - xy[k - 1][1]);
+        }
+        if since >= STEP_SPACING_M {
+            last = step_at(k);
+            since = 0.0;
+        }
+        out.push(last);
+    }
+    out
 }
 
 /// Turns tracks into output edges: height steps, categories per stretch (an edge is cut
@@ -228,8 +243,19 @@ pub fn to_edge_lines(
 ) -> Vec<EdgeLine> {
     let mut out = Vec::new();
     for t in tracks {
-        let xyz: Vec<[f64; 3]> = t.points.iter().map(|&p| pos(input, p)).collect();
-        let xy: Vec<[f64; 2]> = xyz.iter().map(|p| [p[0], p[1]]).collect();
+        let raw: Vec<[f64; 3]> = t
+            .points
+            .iter()
+            .map(|&p| {
+                if params.refine_peak {
+                    refined_pos(input, p)
+                } else {
+                    pos(input, p)
+                }
+            })
+            .collect();
+        let xy: Vec<[f64; 2]> = raw.iter().map(|p| [p[0], p[1]]).collect();
+        let xyz = smooth(&raw, params.smooth_half_window as usize);
         let steps = height_steps(input, grid, route, t, params);
         let cats: Vec<Category> = (0..xy.len())
             .map(|k| {
@@ -262,6 +288,63 @@ pub fn to_edge_lines(
         }
     }
     out
+}
+
+/// The position of the ρ peak at point `p`: the vertex of the parabola through ρ of `p`
+/// and its neighbours on the same scanline (adjacent in time order), at most half-way to
+/// a neighbour; `p` itself where that is not defined.
+fn refined_pos(input: &BendInput, p: u32) -> [f64; 3] {
+    let i = p as usize;
+    let here = pos(input, p);
+    if i == 0 || i + 1 >= input.x.len() {
+        return here;
+    }
+    let ok =
+        |j: usize| input.status[j] == super::STATUS_KEPT && input.scanline[j] == input.scanline[i];
+    if !(ok(i - 1) && ok(i + 1)) {
+        return here;
+    }
+    let (r0, r1, r2) = (
+        input.rho_deg[i - 1] as f64,
+        input.rho_deg[i] as f64,
+        input.rho_deg[i + 1] as f64,
+    );
+    let denom = r0 - 2.0 * r1 + r2;
+    if denom >= -1e-9 {
+        return here;
+    }
+    let delta = (0.5 * (r0 - r2) / denom).clamp(-0.5, 0.5);
+    let j = if delta > 0.0 { i + 1 } else { i - 1 };
+    let q = pos(input, j as u32);
+    let w = delta.abs();
+    [
+        here[0] + w * (q[0] - here[0]),
+        here[1] + w * (q[1] - here[1]),
+        here[2] + w * (q[2] - here[2]),
+    ]
+}
+
+/// Moving average over ±`k` vertices, the window shrinking symmetrically at the ends.
+fn smooth(p: &[[f64; 3]], k: usize) -> Vec<[f64; 3]> {
+    let n = p.len();
+    (0..n)
+        .map(|i| {
+            let h = k.min(i).min(n - 1 - i);
+            let w = (2 * h + 1) as f64;
+            let mut acc = [0.0; 3];
+            // Sum offsets from p[i], not absolute world coordinates, to keep precision.
+            for q in &p[i - h..=i + h] {
+                for c in 0..3 {
+                    acc[c] += q[c] - p[i][c];
+                }
+            }
+            [
+                p[i][0] + acc[0] / w,
+                p[i][1] + acc[1] / w,
+                p[i][2] + acc[2] / w,
+            ]
+        })
+        .collect()
 }
 
 /// Runs `(first, last, category)` of equal category over the vertices (consecutive runs
@@ -377,6 +460,47 @@ mod tests {
                 (11, 20, Category::Curb)
             ]
         );
+    }
+
+    #[test]
+    fn smoothing_averages_inside_and_keeps_the_ends() {
+        let p: Vec<[f64; 3]> = (0..6)
+            .map(|k| [k as f64, if k % 2 == 0 { 0.0 } else { 0.03 }, 1.0])
+            .collect();
+        let s = smooth(&p, 2);
+        assert_eq!(s[0], p[0]);
+        assert_eq!(s[5], p[5]);
+        // Vertex 1: window 0..=2 → y = 0.01; vertex 2: window 0..=4 → y = 0.012.
+        assert!((s[1][1] - 0.01).abs() < 1e-12 && (s[1][0] - 1.0).abs() < 1e-12);
+        assert!((s[2][1] - 0.012).abs() < 1e-12);
+        assert_eq!(smooth(&p, 0), p);
+    }
+
+    #[test]
+    fn peak_refinement_moves_to_the_parabola_vertex() {
+        use crate::io::trajectory::Trajectory;
+        // ρ = 60, 90, 80 at x = 0, 0.02, 0.04: parabola vertex at δ = 0.5·(60 − 80)/
+        // (60 − 180 + 80) = 0.25 points towards the third, x = 0.025.
+        let traj = Trajectory::default();
+        let input = BendInput {
+            x: &[0.0, 0.02, 0.04],
+            y: &[0.0; 3],
+            z: &[1.0; 3],
+            t: &[0.0; 3],
+            rho_deg: &[60.0, 90.0, 80.0],
+            status: &[0; 3],
+            scanline: &[4; 3],
+            candidates: &[],
+            trajectory: &traj,
+        };
+        let q = refined_pos(&input, 1);
+        assert!((q[0] - 0.025).abs() < 1e-12, "{q:?}");
+        // Another scanline next door: no refinement.
+        let input = BendInput {
+            scanline: &[4, 4, 5],
+            ..input
+        };
+        assert_eq!(refined_pos(&input, 1), [0.02, 0.0, 1.0]);
     }
 
     #[test]

@@ -538,3 +538,47 @@ fn bad_input_gives_nothing_and_does_not_panic() {
     };
     assert!(extract_edges(&input, &BendParams::default()).is_empty());
 }
+
+/// Timing on a 300 m road (about 1.5 M points): `cargo test --release -p
+/// curbtrace-host-sim bend::tests::timing -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn timing_300_m() {
+    let cfg = SceneCfg {
+        length_m: 300.0,
+        ..straight(8)
+    };
+    let sc = make_scene(&cfg);
+    let input = sc.input();
+    let p = BendParams::default();
+    let t0 = std::time::Instant::now();
+    let route = route::Route::new(&sc.traj);
+    let grid = grid::PointGrid::build(input.x, input.y, 0.1, |i| input.status[i] != 255);
+    let t1 = t0.elapsed().as_secs_f64();
+    let seeds = seed::seed_points(&input, &route, &p);
+    let t2 = t0.elapsed().as_secs_f64();
+    let tracks = track::track_edges(&input, &grid, &seeds, &p);
+    let t3 = t0.elapsed().as_secs_f64();
+    let tracks = postfilter::remove_under_objects(&input, &grid, tracks, &p);
+    let t4 = t0.elapsed().as_secs_f64();
+    let _ = postfilter::to_edge_lines(&input, &grid, &route, &tracks, &p);
+    let t5 = t0.elapsed().as_secs_f64();
+    eprintln!(
+        "index {t1:.3} seeds {:.3} track {:.3} vehicle {:.3} lines {:.3}",
+        t2 - t1,
+        t3 - t2,
+        t4 - t3,
+        t5 - t4
+    );
+    let t0 = std::time::Instant::now();
+    let edges = extract_edges(&sc.input(), &BendParams::default());
+    let dt = t0.elapsed().as_secs_f64();
+    eprintln!(
+        "{} points, {} edges, {:.3} s, {:.1} M points/s",
+        sc.x.len(),
+        edges.len(),
+        dt,
+        sc.x.len() as f64 / dt / 1e6
+    );
+    assert_eq!(edges.len(), 2);
+}

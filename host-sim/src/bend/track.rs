@@ -238,6 +238,11 @@ pub fn track_edges(
     tracks.into_iter().flatten().collect()
 }
 
+/// Weight of the newest step in the running turn per step (an exponential moving average
+/// over about five steps: long enough to average the toe points' scatter out, short enough
+/// to follow a 4 m corner radius).
+const TURN_EMA: f64 = 0.2;
+
 fn unit3(v: [f64; 3]) -> Option<[f64; 3]> {
     let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     (l > 1e-9).then(|| [v[0] / l, v[1] / l, v[2] / l])
@@ -264,6 +269,9 @@ fn track_one_way(
     let mut own_pts: std::collections::HashSet<u32> = std::collections::HashSet::new();
     own_pts.insert(start);
     let mut gap = 0u32;
+    // Turn of the search direction per step (radians, left positive), averaged: carries
+    // the track round a corner across a gap.
+    let mut turn = 0.0f64;
     let stop_rho = params.stop_rho_deg;
     let d_s = params.search_distance_m;
     let mut set: Vec<usize> = Vec::new();
@@ -308,6 +316,8 @@ fn track_one_way(
             if gap < params.max_gap_steps {
                 gap += 1;
                 cur = pred;
+                let (c, sn) = (turn.cos(), turn.sin());
+                v = [c * v[0] - sn * v[1], sn * v[0] + c * v[1], v[2]];
                 continue;
             }
             break;
@@ -355,12 +365,18 @@ fn track_one_way(
             break;
         };
         // Eq. 8: v_k = a·v_{k−1} + b·v_{k−2} over the last two difference vectors.
-        v = unit3([
+        let v_new = unit3([
             params.a * u[0] + params.b * prev_u[0],
             params.a * u[1] + params.b * prev_u[1],
             params.a * u[2] + params.b * prev_u[2],
         ])
         .unwrap_or(u);
+        if gap == 0 {
+            let dturn =
+                (v[0] * v_new[1] - v[1] * v_new[0]).atan2(v[0] * v_new[0] + v[1] * v_new[1]);
+            turn += TURN_EMA * (dturn - turn);
+        }
+        v = v_new;
         prev_u = u;
         picked.push(n as u32);
         own_pts.insert(n as u32);

@@ -47,6 +47,8 @@
 //! shifted to a local origin first so that squared distances keep their precision with large
 //! CRS offsets.
 
+pub mod report;
+
 use crate::model::{Category, EdgeLine, Side};
 use rayon::prelude::*;
 use rstar::primitives::{GeomWithData, Line};
