@@ -69,6 +69,9 @@ pub struct SectionReport {
     pub width_kept: usize,
     /// Chains kept by the continuity refinement (before clipping to the core).
     pub chains: usize,
+    /// Wall seconds per stage: partition (§3.1), pre-processing (§3.2), normalisation
+    /// (§3.3.1), rough segmentation (§3.3.2), refinement and heights (§3.4).
+    pub stage_s: [f64; 5],
 }
 
 /// What happened overall.
@@ -137,9 +140,7 @@ pub fn extract_edges_with_report(
     let lines = chains
         .into_iter()
         .map(|c| {
-            let mut hs: Vec<f64> = c.h.iter().copied().filter(|h| h.is_finite()).collect();
-            hs.sort_unstable_by(f64::total_cmp);
-            let curb_height_m = (!hs.is_empty()).then(|| hs[hs.len() / 2]);
+            let curb_height_m = refine::median_step(&c);
             let category = curb_height_m.and_then(|h| {
                 if h >= 0.05 {
                     Some(Category::Curb)
@@ -182,6 +183,11 @@ fn process_section(
         return (Vec::new(), rep);
     };
     let o = [origin.x, origin.y, origin.z];
+    let mut clock = std::time::Instant::now();
+    let mut lap = |k: usize, rep: &mut SectionReport| {
+        rep.stage_s[k] = clock.elapsed().as_secs_f64();
+        clock = std::time::Instant::now();
+    };
     // §3.1: the section's GPS time interval, then its width across the trajectory.
     let lo = times.partition_point(|&t| t < sec.t_start);
     let hi = times.partition_point(|&t| t <= sec.t_end);
@@ -196,6 +202,7 @@ fn process_section(
         })
         .collect();
     rep.points_in = raw.len();
+    lap(0, &mut rep);
     // §3.2.
     let pts = if params.sor_after_voxel {
         let v = preprocess::voxel_downsample(&raw, params.voxel_m);
@@ -206,6 +213,7 @@ fn process_section(
     };
     drop(raw);
     rep.points_preprocessed = pts.len();
+    lap(1, &mut rep);
     // §3.3.1.
     let norm = normalise::normalise_to_grid_min(&pts, params.grid_cell_m);
     let pts_norm: Vec<[f64; 3]> = pts
@@ -213,6 +221,7 @@ fn process_section(
         .zip(&norm.z_norm)
         .map(|(p, &z)| [p[0], p[1], z])
         .collect();
+    lap(2, &mut rep);
     // §3.3.2.
     let track = SectionTrack::new(traj, st, sec.t_start - TRACK_PAD_S, sec.t_end + TRACK_PAD_S);
     let locate = |i: usize| track.locate(pts[i][0] + o[0], pts[i][1] + o[1]);
@@ -231,6 +240,7 @@ fn process_section(
     rep.beta_m = seg.beta_m;
     rep.energies = seg.energies.clone();
     rep.candidates = seg.candidates.len();
+    lap(3, &mut rep);
     let edge_pts: Vec<EdgePoint> = seg
         .candidates
         .iter()
@@ -249,15 +259,19 @@ fn process_section(
     rep.road_width_m = width.road_width_m;
     rep.width_kept = width.kept.len();
     let mut chains = refine::refine_by_continuity(&edge_pts, &width.kept, params);
-    rep.chains = chains.len();
     let grid = HeightGrid::new(&pts, o);
     for c in &mut chains {
         grid.measure_steps(c, params.height_band_m);
     }
+    // Ground on both sides (see `QiuParams::min_step_m`), then §3.4.2 step 4.
+    chains.retain(|c| refine::median_step(c).is_some_and(|h| h >= params.min_step_m));
+    let chains = refine::keep_longest(chains, params);
+    rep.chains = chains.len();
     let clipped: Vec<Chain> = chains
         .iter()
         .flat_map(|c| refine::clip_to_stations(c, sec.core_start, sec.core_end))
         .collect();
+    lap(4, &mut rep);
     (clipped, rep)
 }
 

@@ -77,10 +77,16 @@ pub struct QiuParams {
     /// not considered when choosing by E_s (a near-empty set would have a meaningless
     /// variance). Not in the paper.
     pub min_candidates: usize,
-    /// Among candidate sets whose E_s is within this share (plus 0.01 m²) of the smallest,
-    /// the smallest β wins. Not in the paper, which takes the smallest E_s; equally smooth
-    /// sets differ in how low a step they still see.
+    /// Among candidate sets whose E_s is within this share of the smallest, the smallest β
+    /// wins. The paper takes the smallest E_s (0, the default); a tolerance was tried on
+    /// `sapporo` and let road noise (β = 0.01 m) win, so it stays off.
     pub energy_tolerance: f64,
+    /// A road edge has ground on both sides: a chain whose median height step across it
+    /// cannot be measured (fewer than 3 points within `height_band_m` on one side, as at
+    /// the foot of a wall) or is below this is dropped before the longest chains are
+    /// chosen, metres. Not in the paper (its scenes are judged by eye); 0.02 m keeps curb
+    /// cuts (20–30 mm) that were joined into a curb chain.
+    pub min_step_m: f64,
 
     // --- §3.4.1 refinement by road width -------------------------------------------------
     /// Eq. 3: R_i must lie within this distance of the line L_i P_i, metres. Not in the
@@ -154,7 +160,8 @@ impl Default for QiuParams {
             seed: 2016,
             neighbour_radius_m: 0.1,
             min_candidates: 30,
-            energy_tolerance: 0.25,
+            energy_tolerance: 0.0,
+            min_step_m: 0.02,
             width_pair_m: 0.25,
             width_bin_m: 0.1,
             width_tolerance_m: 0.3,
@@ -214,6 +221,7 @@ impl QiuParams {
             ("min_chain_m", self.min_chain_m),
             ("ransac_max_tilt_deg", self.ransac_max_tilt_deg),
             ("energy_tolerance", self.energy_tolerance),
+            ("min_step_m", self.min_step_m),
         ];
         for (name, v) in nonneg {
             if !(v.is_finite() && v >= 0.0) {

@@ -423,8 +423,8 @@ pub fn keep_longest(mut chains: Vec<Chain>, params: &QiuParams) -> Vec<Chain> {
     kept
 }
 
-/// §3.4.2 as a whole on the points kept by the width refinement: clusters per side, line
-/// segments per cluster, joined, longest kept.
+/// §3.4.2 steps 1–3 on the points kept by the width refinement: clusters per side, line
+/// segments per cluster, joined. Step 4 ([`keep_longest`]) follows once heights are known.
 pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParams) -> Vec<Chain> {
     let mut pieces = Vec::new();
     for side in [Side::Left, Side::Right] {
@@ -444,7 +444,13 @@ pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParam
             }
         }
     }
-    keep_longest(join_chains(pieces, params), params)
+    join_chains(pieces, params)
+}
+
+/// The median of the finite height steps of a chain's vertices.
+pub fn median_step(c: &Chain) -> Option<f64> {
+    let mut hs: Vec<f64> = c.h.iter().copied().filter(|h| h.is_finite()).collect();
+    median(&mut hs)
 }
 
 /// Cuts a chain to the stations `[a, b]` (the section's core), interpolating a vertex
@@ -590,7 +596,7 @@ mod tests {
             pts.push(ep(20.0 + k as f64 * 0.25, 3.0));
         }
         let kept: Vec<usize> = (0..pts.len()).collect();
-        let chains = refine_by_continuity(&pts, &kept, &p);
+        let chains = keep_longest(refine_by_continuity(&pts, &kept, &p), &p);
         assert_eq!(chains.len(), 1, "{chains:?}");
         let c = &chains[0];
         assert_eq!(c.side, Side::Left);
