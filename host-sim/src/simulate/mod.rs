@@ -12,6 +12,16 @@
 //! | [`reference`] | the visibility rule and the reference lines |
 //! | [`write`] | LAS 1.4 / LAZ and the trajectory CSV |
 //!
+//! Physics in one paragraph: a full-circle profiler (100 lines/s, 2000 pulses/line, 2 m
+//! above the road, scan plane yawed 45° and tilted 40°, see [`scanner`]) fires every pulse
+//! at its own time from the pose interpolated at that time; a pulse returns from the first
+//! surface it meets — the exact ground with its curbs ([`ground`]) or an object
+//! ([`prims`]) — with Gaussian range noise (σ 5 mm) and rare outliers (2·10⁻⁴, up to metres
+//! off); pulses into the sky, nearer than 1.5 m, or into the vehicle's own body return
+//! nothing. Intensity is Lambertian with material reflectance and speckle. The scan angle
+//! (degrees in the scan plane from its lowest direction, −180° at the top where a line
+//! starts) is stored rounded to LAS units. The reference rule is in [`reference`].
+//!
 //! Determinism: every scan line draws its noise from its own generator seeded by
 //! `(seed, line number)`, and lines are gathered in order, so the output is identical for
 //! any number of threads.
@@ -562,5 +572,9 @@ mod views {
             _ => vec![(15.0, 0.0)],
         };
         render(&which, &dir, &centers, 15.0);
+        if which == "kawasaki" {
+            // Close-ups: weeds and leaves at the left curb; a parked car hiding the curb.
+            render(&which, &dir, &[(30.0, 5.0), (68.0, 4.5)], 3.0);
+        }
     }
 }

@@ -398,7 +398,7 @@ impl World {
             let f = if x <= 0.0 {
                 1.0
             } else {
-                1.0 - smooth01(x / 12.0)
+                1.0 - smooth01(x / 20.0)
             };
             v = v.min(lane + (need - lane) * f);
         }
@@ -627,8 +627,8 @@ impl World {
                     continue;
                 }
                 let e = spec.half_width_at(side, u) + rng.gen_range(-0.12..0.04);
-                let stems = rng.gen_range(6..30);
-                let spread = rng.gen_range(0.05..0.25);
+                let stems = rng.gen_range(15..60);
+                let spread = rng.gen_range(0.05..0.3);
                 let tall = rng.gen_range(0.08..0.45);
                 for _ in 0..stems {
                     let p = center.map(
@@ -639,7 +639,7 @@ impl World {
                     prims.push(Prim {
                         shape: Shape::Cyl {
                             c: p,
-                            r: rng.gen_range(0.0015..0.004),
+                            r: rng.gen_range(0.003..0.008),
                             z: [z - 0.02, z + tall * rng.gen_range(0.3..1.0)],
                         },
                         material: Material::Vegetation,
@@ -984,6 +984,28 @@ mod tests {
         // The last vertex of the first piece is at the side street's end.
         let last = pieces[0].last().unwrap();
         assert!((last.0[0] - 16.0).abs() < 1e-9 && (last.0[1] - 24.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn weeds_stand_at_the_curb_toe_and_stop_rays() {
+        let w = World::build(tiny(), 1);
+        let stems: Vec<_> = w
+            .objects
+            .prims
+            .iter()
+            .filter(|p| p.material == Material::Vegetation)
+            .collect();
+        assert!(stems.len() > 20, "{}", stems.len());
+        let Shape::Cyl { c, r, z } = stems[0].shape else {
+            panic!("weeds are cylinders")
+        };
+        // Near the left toe: |s| < 0.25 m.
+        let (_, toe) = w.ground.height(c[0], c[1]).unwrap();
+        assert!(toe.unwrap().s.abs() < 0.25);
+        // A level ray at mid-height 1 m away hits the stem (or a stem in front of it).
+        let o = [c[0] - 1.0, c[1], 0.5 * (z[0] + z[1])];
+        let h = w.objects.intersect(o, [1.0, 0.0, 0.0], 0.0, 2.0).unwrap();
+        assert!(h.t <= 1.0 - r + 1e-9 && h.material == Material::Vegetation);
     }
 
     #[test]
