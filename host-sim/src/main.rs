@@ -7,7 +7,11 @@ use clap::{Parser, Subcommand};
 mod cli;
 
 #[derive(Parser)]
-#[command(name = "curbtrace", version, about = "Road edges (curb toes) from MLS point clouds")]
+#[command(
+    name = "curbtrace",
+    version,
+    about = "Road edges (curb toes) from MLS point clouds"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

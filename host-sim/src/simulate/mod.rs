@@ -9,8 +9,8 @@
 //! | [`prims`] | walls, fences, parked cars, poles, weeds, leaves, and the ray walk through them |
 //! | [`drive`] | the vehicle's path, speed and attitude → the 200 Hz trajectory |
 //! | [`scanner`] | the VQ-250-like profiler: pulse directions and timing, noise, intensity |
-//! | [`reference`] | the visibility rule and the reference lines |
-//! | [`write`] | LAS 1.4 / LAZ and the trajectory CSV |
+//! | [`reference`](mod@reference) | the visibility rule and the reference lines |
+//! | [`write`](mod@write) | LAS 1.4 / LAZ and the trajectory CSV |
 //!
 //! Physics in one paragraph: a full-circle profiler (100 lines/s, 2000 pulses/line, 2 m
 //! above the road, scan plane yawed 45° and tilted 40°, see [`scanner`]) fires every pulse
@@ -20,7 +20,7 @@
 //! off); pulses into the sky, nearer than 1.5 m, or into the vehicle's own body return
 //! nothing. Intensity is Lambertian with material reflectance and speckle. The scan angle
 //! (degrees in the scan plane from its lowest direction, −180° at the top where a line
-//! starts) is stored rounded to LAS units. The reference rule is in [`reference`].
+//! starts) is stored rounded to LAS units. The reference rule is in [`reference`](mod@reference).
 //!
 //! Determinism: every scan line draws its noise from its own generator seeded by
 //! `(seed, line number)`, and lines are gathered in order, so the output is identical for
