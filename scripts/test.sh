@@ -38,5 +38,34 @@ for feat in libm micromath; do
     -Zbuild-std=core --no-default-features --features "$feat"
 done
 
+# --- firmware: the core on the STM32F405 under QEMU (firmware/check.sh) ----------------------
+step "firmware: cargo fmt --check, clippy on the host target (-D warnings), host-check tests"
+(cd firmware && cargo fmt --check)
+(cd firmware && cargo clippy --release --target x86_64-unknown-linux-gnu --all-targets \
+  --config 'profile.release.panic="abort"' -- -D warnings)
+(cd firmware && cargo test --lib --target x86_64-unknown-linux-gnu)
+HC_TARGET="${CARGO_TARGET_DIR:-$ROOT/target}/firmware-host-check"
+cargo fmt --check --manifest-path firmware/host-check/Cargo.toml
+cargo clippy --manifest-path firmware/host-check/Cargo.toml --target-dir "$HC_TARGET" --all-targets -- -D warnings
+cargo test --manifest-path firmware/host-check/Cargo.toml --target-dir "$HC_TARGET"
+
+step "firmware: a tiny simulated stream through QEMU and the host core, compared (firmware/check.sh)"
+FW_WORK=$(mktemp -d)
+cargo run --release --quiet -p curbtrace-host-sim -- simulate --scene tiny -o "$FW_WORK/sim"
+cargo run --release --quiet -p curbtrace-host-sim -- replay "$FW_WORK/sim/points.laz" \
+  --trajectory "$FW_WORK/sim/trajectory.csv" -o "$FW_WORK/tiny.bin"
+QEMU_TIMEOUT=300 firmware/check.sh "$FW_WORK/tiny.bin"
+rm -rf "$FW_WORK"
+
+step "firmware: a stack overflow, a HardFault and a panic each end the QEMU run with a failure"
+for t in overflow hardfault panic; do
+  rc=0
+  QEMU_TIMEOUT=20 firmware/run-qemu.sh firmware/target/libm/thumbv7em-none-eabihf/release/curbtrace-firmware \
+    --selftest=$t >/dev/null 2>&1 || rc=$?
+  if [ "$rc" -eq 0 ] || [ "$rc" -eq 124 ]; then
+    echo "firmware --selftest=$t: exit status $rc (expected a failure, not success or a hang)"; exit 1
+  fi
+done
+
 echo
 echo "all checks passed"

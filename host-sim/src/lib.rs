@@ -20,6 +20,12 @@
 //! | `plot` | pictures |
 
 pub mod bend;
+pub mod config;
+pub mod eval;
 pub mod io;
 pub mod model;
+pub mod pipeline;
+pub mod plot;
+pub mod qiu;
+pub mod replay;
 pub mod simulate;

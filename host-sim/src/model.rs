@@ -138,7 +138,13 @@ pub fn lines_to_geojson(lines: &[EdgeLine], crs: Option<&Crs>) -> serde_json::Va
             let coords: Vec<Value> = l
                 .points
                 .iter()
-                .map(|p| json!([round_to(p[0], 1e-4), round_to(p[1], 1e-4), round_to(p[2], 1e-4)]))
+                .map(|p| {
+                    json!([
+                        round_to(p[0], 1e-4),
+                        round_to(p[1], 1e-4),
+                        round_to(p[2], 1e-4)
+                    ])
+                })
                 .collect();
             json!({
                 "type": "Feature",
@@ -274,7 +280,11 @@ pub fn read_geojson(path: &std::path::Path) -> Result<(Vec<EdgeLine>, Option<Crs
                 let get = |k: usize| c.get(k).and_then(|x| x.as_f64());
                 let (x, y) = match (get(0), get(1)) {
                     (Some(x), Some(y)) if x.is_finite() && y.is_finite() => (x, y),
-                    _ => return Err(fmt(format!("feature {i}: a position is not two finite numbers"))),
+                    _ => {
+                        return Err(fmt(format!(
+                            "feature {i}: a position is not two finite numbers"
+                        )))
+                    }
                 };
                 points.push([x, y, get(2).unwrap_or(0.0)]);
             }

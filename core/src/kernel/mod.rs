@@ -2,12 +2,40 @@
 //! points, Taubin smoothing, ρ again on the smoothed line, peaks, and the first peak on each
 //! side of the nadir as that side's seed candidate.
 //!
-//! SKELETON: the interface below is fixed (host-sim and firmware build against it); the
-//! bodies are filled in by the kernel work (issue 3).
+//! # One line, in place, O(n)
+//!
+//! [`Kernel::process`] works on the assembled [`Line`] itself:
+//!
+//! 1. [`bend`]: neighbour windows by two sweeps (s forward, t backward), the raw bend angle
+//!    compared with the irregular threshold without atan2 (§2.3–2.4); non-finite points
+//!    are set aside too.
+//! 2. The kept points are moved to the front of the line, in order (a Lomuto partition:
+//!    each kept point swaps with the first set-aside one), so smoothing runs on contiguous
+//!    arrays.
+//! 3. [`smooth`]: Taubin smoothing of the kept points in place (§2.5).
+//! 4. [`bend`] again on the smoothed points: windows and the signed ρ in degrees.
+//! 5. [`seed`]: nadir, peaks, the left and right candidates (§2.6).
+//! 6. The partition is undone by replaying its swaps backwards, so every output slice is
+//!    indexed by input point again; set-aside points get their raw coordinates back.
+//!
+//! # Memory
+//!
+//! Per point of capacity `N`: the line's x′, z′, tag (12 bytes) plus the kernel's ρ (`f32`),
+//! status (`u8`) and one `u8` of working space (the window's right end, later the status of
+//! a kept point) — 18 bytes — plus a 1 KiB deque for the peak search and the parameters.
+//! ρ's buffer doubles as the smoothing scratch before ρ is computed.
 
+use crate::math::{self, Backend};
 use crate::scanline::Line;
 
+pub mod bend;
 mod params;
+#[cfg(all(test, feature = "libm"))]
+mod reference;
+mod seed;
+mod smooth;
+#[cfg(test)]
+mod synth;
 pub use params::{KernelParams, ParamsError, CONFIG_WORDS};
 
 /// What happened to one input point.
@@ -22,6 +50,21 @@ pub enum PointStatus {
     Irregular = 1,
     /// Kept, but has no neighbour within d_b on one side, so no ρ (ρ reported as 0).
     NoNeighbour = 2,
+    /// Removed before anything else: x′ or z′ is NaN or infinite.
+    NonFinite = 3,
+}
+
+impl PointStatus {
+    /// The status with wire value `v`, if any.
+    pub fn from_u8(v: u8) -> Option<Self> {
+        match v {
+            0 => Some(Self::Kept),
+            1 => Some(Self::Irregular),
+            2 => Some(Self::NoNeighbour),
+            3 => Some(Self::NonFinite),
+            _ => None,
+        }
+    }
 }
 
 /// Counters of one scanline (every point that entered is in exactly one of the
@@ -37,8 +80,15 @@ pub struct KernelCounters {
     pub irregular: u32,
     /// Points with status [`PointStatus::NoNeighbour`].
     pub no_neighbour: u32,
+    /// Points with status [`PointStatus::NonFinite`].
+    pub non_finite: u32,
     /// Peaks found (§2.6).
     pub peaks: u32,
+    /// Neighbour windows (raw and smoothed pass) that stopped at [`bend::MAX_SIDE`] points
+    /// with the next point still within d_b (degenerate input: many returns on one spot).
+    pub capped_windows: u32,
+    /// Pieces the line was smoothed in (split at gaps, see [`KernelParams::smooth_gap_m`]).
+    pub smooth_pieces: u32,
 }
 
 /// The kernel's result for one scanline, borrowed from the kernel's buffers (no copies).
@@ -52,9 +102,9 @@ pub struct ScanlineOutput<'a> {
     pub params_hash: u32,
     /// Per point: the pass-through tag.
     pub tag: &'a [u32],
-    /// Per point: smoothed x′ in metres (raw x′ for irregular points).
+    /// Per point: smoothed x′ in metres (raw x′ for irregular and non-finite points).
     pub x_m: &'a [f32],
-    /// Per point: smoothed z′ in metres (raw z′ for irregular points).
+    /// Per point: smoothed z′ in metres (raw z′ for irregular and non-finite points).
     pub z_m: &'a [f32],
     /// Per point: bend angle ρ in degrees on the smoothed line, (−180, 180]; 0 where the
     /// status is not [`PointStatus::Kept`].
@@ -73,18 +123,50 @@ pub struct ScanlineOutput<'a> {
     pub counters: KernelCounters,
 }
 
-/// The per-scanline kernel with its fixed-size working memory for lines of up to `N` points.
+/// Values derived from the parameters once, not per line.
+#[derive(Clone, Copy, Debug)]
+struct Derived {
+    d2: f32,
+    irregular: bend::Threshold,
+}
+
+impl Derived {
+    fn new(p: &KernelParams) -> Self {
+        Self {
+            d2: p.d_b_m * p.d_b_m,
+            irregular: bend::Threshold::new(p.irregular_deg),
+        }
+    }
+}
+
+/// The per-scanline kernel with its fixed-size working memory for lines of up to `N` points
+/// (`N` ≤ 65 535, so that every index fits the `u16` of the output).
 pub struct Kernel<const N: usize> {
     params: KernelParams,
     params_hash: u32,
+    derived: Derived,
+    /// ρ per point (smoothing scratch before that).
+    rho: [f32; N],
+    /// Status per input point.
+    status: [PointStatus; N],
+    /// Per point: t(i) − i, then the status of a kept point (compact order).
+    aux: [u8; N],
+    /// The peak search's window-maximum deque.
+    deque: [u16; seed::DEQUE_LEN],
 }
 
 impl<const N: usize> Kernel<N> {
-    /// A kernel running `params`.
+    /// A kernel running `params` (taken as they are; [`Kernel::set_params`] checks them).
     pub fn new(params: KernelParams) -> Self {
+        const { assert!(N <= u16::MAX as usize, "Kernel<N>: N must fit a u16 index") };
         Self {
             params_hash: params.hash(),
+            derived: Derived::new(&params),
             params,
+            rho: [0.0; N],
+            status: [PointStatus::Kept; N],
+            aux: [0; N],
+            deque: [0; seed::DEQUE_LEN],
         }
     }
 
@@ -93,10 +175,147 @@ impl<const N: usize> Kernel<N> {
         &self.params
     }
 
+    /// Replaces the parameters after checking them; on error the old ones stay.
+    pub fn set_params(&mut self, params: KernelParams) -> Result<(), ParamsError> {
+        params.validate()?;
+        self.params = params;
+        self.params_hash = params.hash();
+        self.derived = Derived::new(&params);
+        Ok(())
+    }
+
     /// Processes one assembled line in place and returns the result borrowed from the
     /// kernel's buffers and the line.
     pub fn process<'a>(&'a mut self, line: &'a mut Line<N>) -> ScanlineOutput<'a> {
-        let _ = (&self.params, self.params_hash, line);
-        todo!("issue 3")
+        self.process_with::<math::Selected>(line)
+    }
+
+    /// [`Kernel::process`] with an explicit maths backend (the micromath tolerance test
+    /// runs both backends in one build).
+    pub(crate) fn process_with<'a, M: Backend>(
+        &'a mut self,
+        line: &'a mut Line<N>,
+    ) -> ScanlineOutput<'a> {
+        let n = line.len.min(N);
+        let p = self.params;
+        let Derived { d2, irregular } = self.derived;
+        let mut c = KernelCounters {
+            points_in: n as u32,
+            ..KernelCounters::default()
+        };
+        let x = &mut line.x_m[..n];
+        let z = &mut line.z_m[..n];
+        let rho = &mut self.rho[..n];
+        let status = &mut self.status[..n];
+        let aux = &mut self.aux[..n];
+
+        // 1. §2.3–2.4 on the raw line.
+        c.capped_windows += bend::right_windows(x, z, d2, aux);
+        let (irr, non_finite) = bend::mark_irregular(x, z, aux, d2, irregular, status);
+        c.irregular = irr;
+        c.non_finite = non_finite;
+        let kept = n - (irr + non_finite) as usize;
+
+        // 2. Kept points to the front, in order.
+        if kept < n {
+            let mut w = 0;
+            for (i, st) in status.iter().enumerate() {
+                if *st == PointStatus::Kept {
+                    x.swap(w, i);
+                    z.swap(w, i);
+                    w += 1;
+                }
+            }
+        }
+
+        // 3. §2.5 on the kept points; ρ's buffer is the scratch.
+        let (xk, zk) = (&mut x[..kept], &mut z[..kept]);
+        c.smooth_pieces = smooth::taubin_smooth(
+            xk,
+            zk,
+            rho,
+            p.smooth_gap_m,
+            p.taubin_steps,
+            p.taubin_lambda,
+            p.taubin_mu,
+        );
+
+        // 4. ρ on the smoothed line.
+        c.capped_windows += bend::right_windows(xk, zk, d2, &mut aux[..kept]);
+        bend::bend_angles::<M>(xk, zk, &aux[..kept], d2, &mut rho[..kept]);
+        rho[kept..].fill(0.0);
+
+        // 5. §2.6: nadir, peaks, candidates (compact indices).
+        let nadir = seed::nadir(xk, zk);
+        let seeds = seed::seed_candidates(
+            xk,
+            zk,
+            &rho[..kept],
+            &mut aux[..kept],
+            d2,
+            p.tau_min_deg,
+            p.tau_max_deg,
+            nadir,
+            &mut self.deque,
+        );
+        c.peaks = seeds.peaks;
+        c.no_neighbour = seeds.no_neighbour;
+        c.kept = kept as u32 - seeds.no_neighbour;
+
+        // 6. Back to input order: replay the partition's swaps backwards.
+        let mut idx = [nadir, seeds.left, seeds.right];
+        if kept == n {
+            for (st, &a) in status.iter_mut().zip(aux.iter()) {
+                *st = status_of(a);
+            }
+        } else {
+            let mut w = kept;
+            let mut map = idx;
+            for i in (0..n).rev() {
+                if status[i] == PointStatus::Kept {
+                    w -= 1;
+                    x.swap(w, i);
+                    z.swap(w, i);
+                    rho.swap(w, i);
+                    status[i] = status_of(aux[w]);
+                    for (m, o) in map.iter_mut().zip(idx.iter()) {
+                        if *o == Some(w) {
+                            *m = Some(i);
+                        }
+                    }
+                }
+            }
+            idx = map;
+        }
+        let [nadir, left, right] = idx.map(|o| o.map(|i| i as u16));
+
+        ScanlineOutput {
+            index: line.index,
+            start_time_ns: line.start_time_ns,
+            params_hash: self.params_hash,
+            tag: &line.tag[..n],
+            x_m: &line.x_m[..n],
+            z_m: &line.z_m[..n],
+            rho_deg: &self.rho[..n],
+            status: &self.status[..n],
+            nadir,
+            left,
+            right,
+            truncated: line.truncated,
+            counters: c,
+        }
     }
 }
+
+/// The status a kept point's `u8` in the working buffer stands for.
+#[inline]
+fn status_of(a: u8) -> PointStatus {
+    if a == PointStatus::NoNeighbour as u8 {
+        PointStatus::NoNeighbour
+    } else {
+        PointStatus::Kept
+    }
+}
+
+#[cfg(all(test, feature = "libm"))]
+mod tests;

@@ -1,5 +1,26 @@
-//! [`KernelParams`]: every parameter of the kernel, with defaults, carried in the stream's
-//! config packet as [`CONFIG_WORDS`] little-endian words.
+//! [`KernelParams`]: every parameter of the kernel (and of scanline assembly), with
+//! defaults, carried in the stream's config packet as [`CONFIG_WORDS`] little-endian words.
+//!
+//! # Config words
+//!
+//! | word | field | encoding | accepted range |
+//! |---|---|---|---|
+//! | 0 | [`KernelParams::d_b_m`] | f32 bits | (0, 10] |
+//! | 1 | [`KernelParams::irregular_deg`] | f32 bits | (0, 180] |
+//! | 2 | [`KernelParams::tau_min_deg`] | f32 bits | [0, 180) |
+//! | 3 | [`KernelParams::tau_max_deg`] | f32 bits | (τ_min, 180] |
+//! | 4 | [`KernelParams::taubin_steps`] | u32 | 0..=200 |
+//! | 5 | [`KernelParams::taubin_lambda`] | f32 bits | (0, 1] |
+//! | 6 | [`KernelParams::taubin_mu`] | f32 bits | [−1, 0) |
+//! | 7 | [`KernelParams::smooth_gap_m`] | f32 bits | [0, 100] |
+//! | 8 | [`KernelParams::split_gap_ns`] | u32 | any |
+//! | 9 | [`KernelParams::split_jump_m`] | f32 bits | [0, 1000] |
+//! | 10 | [`KernelParams::split_above_m`] | f32 bits | [−100, 100] |
+//! | 11–15 | reserved | 0 | 0 |
+//!
+//! NaN and infinities are out of range for every f32 word. The words round-trip exactly
+//! (`from_words(p.to_words()) == Ok(p)`), and [`KernelParams::hash`] is FNV-1a over their
+//! little-endian bytes, so the same words always give the same hash on every platform.
 
 /// Number of 32-bit words of the config packet's parameter block.
 pub const CONFIG_WORDS: usize = 16;
@@ -21,28 +42,299 @@ pub enum ParamsError {
     },
 }
 
-/// Every parameter of the kernel (and of scanline assembly). SKELETON: fields and defaults
-/// are settled by issue 3; each one says where its value comes from.
+/// Every parameter of the kernel (Honma et al. §2.3–2.6) and of scanline assembly (SPEC §2,
+/// *Scanline*), so that one config packet configures the whole core.
+///
+/// The paper gives the Taubin values (§2.5) and nothing else numerically; every other
+/// default below says how it was chosen. The target is a VQ-250-class line (SPEC, paper
+/// Table 1): about 10 mm point spacing on the road near the scanner, about 35 mm at 5 m,
+/// up to about 140 mm at the far curb; curbs 80–200 mm high; curb cuts 20–30 mm steps.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct KernelParams {
-    /// d_b: neighbour distance for the bend angle, metres (§2.3).
+    /// d_b: neighbour distance for the bend angle, metres (§2.3: s and t are the farthest
+    /// points within d_b of p_i, walking outward along the scanline).
+    ///
+    /// Default 0.07 m — not given by the paper. Chosen to stay below the height of the
+    /// lowest common curbs (80 mm): with d_b < h the toe of a step is a sharp +90° peak (s on
+    /// the road, t on the face), while with d_b > h the far neighbour lands on the curb top
+    /// for every road point within √(d_b² − h²) of the toe and ρ forms a plateau of
+    /// asin(h/d_b) there, which lets noise place the peak anywhere on it. Measured on the
+    /// synthetic scanline (`kernel::tests`, 5 mm noise, 80 runs): 80 mm curbs give a worst
+    /// candidate 20 mm from the toe with 0.07 m against 61 mm with 0.10 m and 97 mm with
+    /// 0.13 m; 150 mm curbs are the same for all three (≤ 19 mm). 0.07 m still spans 7
+    /// points at 10 mm spacing and 2 at 35 mm (5 m out), enough to average the noise. At
+    /// the far curb (≈140 mm spacing) road points have no neighbour within d_b and get
+    /// [`super::PointStatus::NoNeighbour`]; the host's tracking (§2.7) covers that side.
     pub d_b_m: f32,
+    /// Threshold for the removal of irregular points, degrees (§2.4: points with |ρ| above
+    /// it on the raw line are removed before smoothing).
+    ///
+    /// Default 120° — not given by the paper. It must stay well above 90°, or the raw toe
+    /// and top of every curb (±90° plus noise) would be removed as irregular; 120° leaves
+    /// 30° for noise on a sharp corner, and still removes spikes: a point sticking out more
+    /// than sin(60°)·d_b ≈ 61 mm from a flat surface has |ρ| > 120° and goes (one sticking
+    /// out more than d_b has no neighbour at all and is judged by its adjacent points, see
+    /// `bend::mark_irregular`).
+    pub irregular_deg: f32,
+    /// τ_ρmin: lower bound (exclusive) of the bend angle of a peak, degrees (§2.6).
+    ///
+    /// Default 35° — not given by the paper ("close to 90 degrees"). Far below the toe of
+    /// any curb taller than d_b (≈90°, somewhat less after smoothing rounds the corner) and
+    /// below a 40 mm step's asin(0.04/0.07) ≈ 35°, yet well above road crown, ruts and the
+    /// 5 mm noise left after smoothing (a few degrees; no false candidate in the 80
+    /// synthetic runs). Curb cuts (20–30 mm steps, ρ ≈ 17–25°) give no peak; the host
+    /// tracks through them (§2.7).
+    pub tau_min_deg: f32,
+    /// τ_ρmax: upper bound (exclusive) of the bend angle of a peak, degrees (§2.6).
+    ///
+    /// Default 150° — not given by the paper. A toe seen from the road is about 90°; a
+    /// thin spike that survived §2.4 can reach 180°. 150° keeps toes with some overhang or
+    /// batter and drops needle-like returns.
+    pub tau_max_deg: f32,
+    /// Number of Taubin smoothing steps (§2.5: 20, chosen by the paper's experiment).
+    pub taubin_steps: u32,
+    /// Taubin scale factor of the even steps, λ (§2.5: 0.6307, after Taubin 1995).
+    pub taubin_lambda: f32,
+    /// Taubin scale factor of the odd steps, μ (§2.5: −0.6732, after Taubin 1995).
+    pub taubin_mu: f32,
+    /// Gap that splits the line for smoothing, metres: where two consecutive kept points
+    /// are farther apart than this, the line is smoothed as separate pieces, each with its
+    /// end points fixed (0 = never split).
+    ///
+    /// Default 0.30 m — an addition to the paper, which smooths the whole line. Across an
+    /// occlusion shadow the next point can be metres away, and Taubin's step response
+    /// would pull the points beside the gap towards it by centimetres, creating false
+    /// bends; fixing both sides of a gap keeps the paper's "ends fixed" per visible piece.
+    /// 0.30 m is twice the largest spacing expected on the road (≈140 mm at the far curb).
+    pub smooth_gap_m: f32,
+    /// Assembly: a pause between consecutive points longer than this ends the line,
+    /// nanoseconds (0 = off). Used only when the stream carries no line-start flags.
+    ///
+    /// Default 0 (off) — the side-change rule below splits lines on its own; a scanner
+    /// integration that knows its line period may set about half of it.
+    pub split_gap_ns: u32,
+    /// Assembly: a change of side of x′ between consecutive points splits the line when
+    /// the two points are more than this apart in x′, metres (a jump over the sky or the
+    /// vehicle; at the nadir consecutive points are millimetres apart, so a crossing below
+    /// the scanner never splits).
+    ///
+    /// Default 1.0 m — well above the nadir spacing (≈10 mm) and well below the jump from
+    /// one side to the other over the top (metres).
+    pub split_jump_m: f32,
+    /// Assembly: a change of side of x′ between two consecutive points that are both higher
+    /// than this (z′, metres, relative to the scanner) also splits the line — the crossing
+    /// happens above the scanner, e.g. on a tunnel ceiling or a tree canopy where
+    /// consecutive returns are close together.
+    ///
+    /// Default 0.0 m: the scanner's own height; the nadir crossing is always below it.
+    pub split_above_m: f32,
 }
 
-impl KernelParams {
-    /// The defaults.
-    pub const DEFAULT: Self = Self { d_b_m: 0.1 };
+/// Index of the first reserved word.
+const FIRST_RESERVED: usize = 11;
 
-    /// A stable 32-bit hash of the parameter words (echoed in every output packet).
+impl KernelParams {
+    /// The defaults (see each field for how its value was chosen).
+    pub const DEFAULT: Self = Self {
+        d_b_m: 0.07,
+        irregular_deg: 120.0,
+        tau_min_deg: 35.0,
+        tau_max_deg: 150.0,
+        taubin_steps: 20,
+        taubin_lambda: 0.6307,
+        taubin_mu: -0.6732,
+        smooth_gap_m: 0.30,
+        split_gap_ns: 0,
+        split_jump_m: 1.0,
+        split_above_m: 0.0,
+    };
+
+    /// The parameter block as config-packet words (see the module's table).
+    pub fn to_words(&self) -> [u32; CONFIG_WORDS] {
+        let mut w = [0u32; CONFIG_WORDS];
+        w[0] = self.d_b_m.to_bits();
+        w[1] = self.irregular_deg.to_bits();
+        w[2] = self.tau_min_deg.to_bits();
+        w[3] = self.tau_max_deg.to_bits();
+        w[4] = self.taubin_steps;
+        w[5] = self.taubin_lambda.to_bits();
+        w[6] = self.taubin_mu.to_bits();
+        w[7] = self.smooth_gap_m.to_bits();
+        w[8] = self.split_gap_ns;
+        w[9] = self.split_jump_m.to_bits();
+        w[10] = self.split_above_m.to_bits();
+        w
+    }
+
+    /// Parses and checks a parameter block; the first offending word is reported.
+    pub fn from_words(words: &[u32; CONFIG_WORDS]) -> Result<Self, ParamsError> {
+        // `lo_open`: whether the lower bound itself is excluded.
+        fn f(
+            words: &[u32; CONFIG_WORDS],
+            index: usize,
+            lo: f32,
+            lo_open: bool,
+            hi: f32,
+            hi_open: bool,
+        ) -> Result<f32, ParamsError> {
+            let v = f32::from_bits(words[index]);
+            // NaN fails every comparison, so it is rejected here too.
+            let above = if lo_open { v > lo } else { v >= lo };
+            let below = if hi_open { v < hi } else { v <= hi };
+            if above && below {
+                Ok(v)
+            } else {
+                Err(ParamsError::OutOfRange { index: index as u8 })
+            }
+        }
+        for (index, &w) in words.iter().enumerate().skip(FIRST_RESERVED) {
+            if w != 0 {
+                return Err(ParamsError::ReservedNotZero { index: index as u8 });
+            }
+        }
+        let d_b_m = f(words, 0, 0.0, true, 10.0, false)?;
+        let irregular_deg = f(words, 1, 0.0, true, 180.0, false)?;
+        let tau_min_deg = f(words, 2, 0.0, false, 180.0, true)?;
+        let tau_max_deg = f(words, 3, tau_min_deg, true, 180.0, false)?;
+        let taubin_steps = words[4];
+        if taubin_steps > 200 {
+            return Err(ParamsError::OutOfRange { index: 4 });
+        }
+        let taubin_lambda = f(words, 5, 0.0, true, 1.0, false)?;
+        let taubin_mu = f(words, 6, -1.0, false, 0.0, true)?;
+        let smooth_gap_m = f(words, 7, 0.0, false, 100.0, false)?;
+        let split_gap_ns = words[8];
+        let split_jump_m = f(words, 9, 0.0, false, 1000.0, false)?;
+        let split_above_m = f(words, 10, -100.0, false, 100.0, false)?;
+        Ok(Self {
+            d_b_m,
+            irregular_deg,
+            tau_min_deg,
+            tau_max_deg,
+            taubin_steps,
+            taubin_lambda,
+            taubin_mu,
+            smooth_gap_m,
+            split_gap_ns,
+            split_jump_m,
+            split_above_m,
+        })
+    }
+
+    /// Checks the parameters against the ranges of the config words (the same check as
+    /// [`Self::from_words`]).
+    pub fn validate(&self) -> Result<(), ParamsError> {
+        Self::from_words(&self.to_words()).map(|_| ())
+    }
+
+    /// A stable 32-bit hash of the parameter words (echoed in every output packet):
+    /// 32-bit FNV-1a over the little-endian bytes of [`Self::to_words`].
     pub fn hash(&self) -> u32 {
-        let _ = self;
-        0
+        let mut h: u32 = 0x811c_9dc5;
+        for w in self.to_words() {
+            for b in w.to_le_bytes() {
+                h ^= u32::from(b);
+                h = h.wrapping_mul(0x0100_0193);
+            }
+        }
+        h
     }
 }
 
 impl Default for KernelParams {
     fn default() -> Self {
         Self::DEFAULT
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_round_trip() {
+        let p = KernelParams::DEFAULT;
+        assert_eq!(p.validate(), Ok(()));
+        assert_eq!(KernelParams::from_words(&p.to_words()), Ok(p));
+        // The paper's Taubin values (§2.5).
+        assert_eq!(p.taubin_steps, 20);
+        assert_eq!(p.taubin_lambda, 0.6307);
+        assert_eq!(p.taubin_mu, -0.6732);
+    }
+
+    #[test]
+    fn word_layout_is_fixed() {
+        let w = KernelParams::DEFAULT.to_words();
+        assert_eq!(w[0], 0.07f32.to_bits());
+        assert_eq!(w[0], 0x3d8f_5c29);
+        assert_eq!(w[4], 20);
+        assert_eq!(w[6], (-0.6732f32).to_bits());
+        assert!(w[FIRST_RESERVED..].iter().all(|&x| x == 0));
+    }
+
+    #[test]
+    fn hash_is_fnv1a_of_the_words() {
+        // FNV-1a of 64 zero bytes, computed by hand from the definition: each zero byte
+        // leaves the xor unchanged, so h = offset · prime^64 (mod 2^32).
+        let mut expect: u32 = 0x811c_9dc5;
+        for _ in 0..64 {
+            expect = expect.wrapping_mul(0x0100_0193);
+        }
+        let zero = KernelParams {
+            d_b_m: 0.0,
+            irregular_deg: 0.0,
+            tau_min_deg: 0.0,
+            tau_max_deg: 0.0,
+            taubin_steps: 0,
+            taubin_lambda: 0.0,
+            taubin_mu: 0.0,
+            smooth_gap_m: 0.0,
+            split_gap_ns: 0,
+            split_jump_m: 0.0,
+            split_above_m: 0.0,
+        };
+        assert_eq!(zero.hash(), expect);
+        let a = KernelParams::DEFAULT;
+        let b = KernelParams {
+            d_b_m: 0.11,
+            ..KernelParams::DEFAULT
+        };
+        assert_ne!(a.hash(), b.hash());
+        assert_eq!(a.hash(), KernelParams::DEFAULT.hash());
+    }
+
+    #[test]
+    fn bad_words_are_rejected_with_their_index() {
+        let good = KernelParams::DEFAULT.to_words();
+        let cases: [(usize, u32); 12] = [
+            (0, f32::NAN.to_bits()),
+            (0, 0.0f32.to_bits()),
+            (0, (-0.1f32).to_bits()),
+            (1, f32::INFINITY.to_bits()),
+            (1, 181.0f32.to_bits()),
+            (2, (-1.0f32).to_bits()),
+            (3, 30.0f32.to_bits()), // below τ_min = 35
+            (4, 201),
+            (5, 1.5f32.to_bits()),
+            (6, 0.5f32.to_bits()),
+            (7, f32::NEG_INFINITY.to_bits()),
+            (10, 1000.0f32.to_bits()),
+        ];
+        for (index, bad) in cases {
+            let mut w = good;
+            w[index] = bad;
+            assert_eq!(
+                KernelParams::from_words(&w),
+                Err(ParamsError::OutOfRange { index: index as u8 }),
+                "word {index}"
+            );
+        }
+        let mut w = good;
+        w[13] = 1;
+        assert_eq!(
+            KernelParams::from_words(&w),
+            Err(ParamsError::ReservedNotZero { index: 13 })
+        );
     }
 }

@@ -5,7 +5,11 @@
 //! processes it in place.
 
 pub mod assemble;
+mod ingest;
 pub mod ring;
+
+pub use assemble::{GeometrySplit, SplitParams, SplitReason};
+pub use ingest::{Ingest, IngestCounters, IngestEvent};
 
 /// One assembled scanline in structure-of-arrays form (SPEC §2: points in acquisition order,
 /// one revolution of the mirror). Filled by [`assemble::Assembler`], processed in place by

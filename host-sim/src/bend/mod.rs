@@ -1,9 +1,22 @@
 //! The bend-angle method's host half (Honma et al. §2.6–2.7): seeding by RANSAC per
-//! interval, tracking by the energy of Eq. 4–8, post-filters. SKELETON: filled in by
-//! issue 4.
+//! interval ([`seed`]), tracking by the energy of Eq. 4–8 ([`track`]), post-filters and
+//! the edges' properties ([`postfilter`]). It reads the core's output as it is (its ρ and
+//! its candidates) and never recomputes them.
+//!
+//! Everything here is sequential and uses only seeded randomness, so the output is the same
+//! on every run and whatever the thread count.
 
 use crate::io::trajectory::Trajectory;
-use crate::model::Side;
+use crate::model::{EdgeLine, Side};
+
+pub mod grid;
+pub mod params;
+pub mod postfilter;
+pub mod route;
+pub mod seed;
+pub mod track;
+
+pub use params::BendParams;
 
 /// A seed candidate from the core: the first peak outward from the nadir on one side of
 /// one scanline.
@@ -44,3 +57,70 @@ pub struct BendInput<'a> {
     /// The trajectory.
     pub trajectory: &'a Trajectory,
 }
+
+impl<'a> BendInput<'a> {
+    /// The same input with every column cut to the shortest column's length, so that no
+    /// index taken from one column can fall outside another.
+    fn truncated(&self) -> BendInput<'a> {
+        let n = [
+            self.x.len(),
+            self.y.len(),
+            self.z.len(),
+            self.t.len(),
+            self.rho_deg.len(),
+            self.status.len(),
+            self.scanline.len(),
+        ]
+        .into_iter()
+        .min()
+        .unwrap_or(0);
+        BendInput {
+            x: &self.x[..n],
+            y: &self.y[..n],
+            z: &self.z[..n],
+            t: &self.t[..n],
+            rho_deg: &self.rho_deg[..n],
+            status: &self.status[..n],
+            scanline: &self.scanline[..n],
+            candidates: self.candidates,
+            trajectory: self.trajectory,
+        }
+    }
+}
+
+/// Extracts the road edges (Honma et al. §2.6–2.7): seeds by RANSAC per interval, tracks
+/// from every seed in both directions, removes short edges, edges under vehicles and edges
+/// outside the roadway, and returns each edge once with `method = "bend"`, its side, its
+/// median height step and a category per stretch.
+pub fn extract_edges(input: &BendInput, params: &BendParams) -> Vec<EdgeLine> {
+    let input = input.truncated();
+    let route = route::Route::new(input.trajectory);
+    // One index over every processed point: tracking reads the kept ones, the vehicle
+    // filter and the height step read all.
+    let cell_m = params.search_radius_m.clamp(0.05, 1.0);
+    let grid = grid::PointGrid::build(input.x, input.y, cell_m, |i| {
+        input.status[i] != STATUS_NOT_PROCESSED
+    });
+    let mut seeds = seed::seed_points(&input, &route, params);
+    // Best-fitting seeds first: the first track along a curb claims it, later seeds on the
+    // same curb start nothing.
+    seeds.sort_by(|a, b| {
+        b.inlier_ratio
+            .total_cmp(&a.inlier_ratio)
+            .then(a.side.cmp(&b.side))
+            .then(a.interval.cmp(&b.interval))
+            .then(a.point.cmp(&b.point))
+    });
+    let tracks = track::track_edges(&input, &grid, &seeds, params);
+    let tracks = postfilter::remove_short(&input, tracks, params);
+    let tracks = postfilter::remove_under_objects(&input, &grid, tracks, params);
+    let tracks = if params.roadway_filter {
+        postfilter::remove_outside_roadway(&input, &route, tracks)
+    } else {
+        tracks
+    };
+    postfilter::to_edge_lines(&input, &grid, &route, &tracks, params)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,10 +1,102 @@
-//! `curbtrace extract` (SKELETON: not implemented yet).
+//! `curbtrace extract POINTS --trajectory CSV -o EDGES.geojson` — the main job (SPEC §4).
+
+use anyhow::Context;
+use curbtrace_host_sim::config::Config;
+use curbtrace_host_sim::model;
+use curbtrace_host_sim::pipeline::{self, ExtractOptions, Method, Progress};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+/// Output format of the edges.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    /// GeoJSON FeatureCollection with the LAS CRS (SPEC §3).
+    Geojson,
+    /// Plain vertex lists: `edge,side,vertex,x,y,z`.
+    Csv,
+}
+
+/// Method names on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodArg {
+    /// Bend angle of scanlines (Honma et al.), through the core.
+    Bend,
+    /// Plane-based (Qiu et al.).
+    Qiu,
+}
 
 /// Arguments of `curbtrace extract`.
 #[derive(clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// LAS or LAZ point file (formats with GPS time: 1, 3, 4, 5, 6–10).
+    #[arg(required_unless_present = "print_config")]
+    pub points: Option<PathBuf>,
+    /// Trajectory CSV: time,x,y,z,roll,pitch,heading (GPS time in the LAS time base).
+    #[arg(long, required_unless_present = "print_config")]
+    pub trajectory: Option<PathBuf>,
+    /// Output file (GeoJSON, or CSV with --format csv).
+    #[arg(short, long, required_unless_present = "print_config")]
+    pub output: Option<PathBuf>,
+    /// Method.
+    #[arg(long, value_enum, default_value = "bend")]
+    pub method: MethodArg,
+    /// Scanner: LAS 1.4 scanner channel (when the file uses channels) or point source id.
+    #[arg(long)]
+    pub scanner: Option<u16>,
+    /// TOML file with parameters (see --print-config).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Output format.
+    #[arg(long, value_enum, default_value = "geojson")]
+    pub format: Format,
+    /// Prints the configuration in force (defaults, or --config's) as TOML and exits.
+    #[arg(long)]
+    pub print_config: bool,
+    /// No summary on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
 
 /// Runs `curbtrace extract`.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("curbtrace extract is not implemented yet")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let cfg = match &args.config {
+        Some(p) => Config::read(p)?,
+        None => Config::default(),
+    };
+    if args.print_config {
+        print!(
+            "{}",
+            toml::to_string_pretty(&cfg).context("printing the config")?
+        );
+        return Ok(());
+    }
+    let (Some(points), Some(trajectory), Some(output)) =
+        (&args.points, &args.trajectory, &args.output)
+    else {
+        anyhow::bail!("POINTS, --trajectory and -o are required");
+    };
+    let opts = ExtractOptions {
+        scanner: args.scanner,
+        method: match args.method {
+            MethodArg::Bend => Method::Bend,
+            MethodArg::Qiu => Method::Qiu,
+        },
+    };
+    let progress = if std::io::stderr().is_terminal() && !args.quiet {
+        Progress::bar()
+    } else {
+        Progress::hidden()
+    };
+    let result = pipeline::extract_file_with(points, trajectory, &cfg, &opts, &progress)?;
+    progress.finish();
+    match args.format {
+        Format::Geojson => model::write_geojson(output, &result.edges, result.crs.as_ref())?,
+        Format::Csv => pipeline::write_edges_csv(output, &result.edges)
+            .with_context(|| format!("{}: writing the edges", output.display()))?,
+    }
+    if !args.quiet {
+        eprintln!("{}", result.summary.to_text());
+        eprintln!("written            {}", output.display());
+    }
+    Ok(())
 }

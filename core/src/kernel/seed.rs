@@ -1,0 +1,192 @@
+//! Peaks, nadir and the per-scanline seed candidates (Honma et al. §2.6, SPEC §2).
+//!
+//! - Nadir: the point with the smallest |x′| among points with z′ < 0 (first one on a tie).
+//! - Peak: ρ_i is the largest ρ within i's d_b window (ties count: ρ_i ≥ every ρ_j in the
+//!   window) and τ_min < ρ_i < τ_max; a point without a neighbour on a side has no ρ and
+//!   is never a peak.
+//! - Candidates: walking outward from the nadir in scan order (both ways at once), the
+//!   first peak with x′ > 0 is the left candidate and the first with x′ < 0 the right one.
+//!   "First" is the smallest |k − nadir|; a tie between the two directions goes to the
+//!   smaller |x′| (nearer the vehicle), then the lower index.
+//!
+//! The window maximum comes from a monotone deque over the same two-index windows as ρ
+//! (both ends only move forward), so the whole pass is O(n). Its length never exceeds
+//! 2·[`MAX_SIDE`] + 2 = [`DEQUE_LEN`] (the indices between s(k−1) and t(k)).
+
+use super::bend::{left_neighbour, MAX_SIDE};
+use super::PointStatus;
+
+/// Capacity of the peak search's deque (a power of two ≥ 2·MAX_SIDE + 2).
+pub(crate) const DEQUE_LEN: usize = 512;
+const _: () = assert!(DEQUE_LEN >= 2 * MAX_SIDE + 2 && DEQUE_LEN.is_power_of_two());
+
+/// The smallest |x′| among points with z′ < 0.
+pub(crate) fn nadir(x: &[f32], z: &[f32]) -> Option<usize> {
+    let mut best: Option<(usize, f32)> = None;
+    for (i, (&xi, &zi)) in x.iter().zip(z).enumerate() {
+        let ax = crate::math::abs(xi);
+        if zi < 0.0 && best.is_none_or(|(_, b)| ax < b) {
+            best = Some((i, ax));
+        }
+    }
+    best.map(|(i, _)| i)
+}
+
+/// What the peak pass found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Seeds {
+    /// Number of peaks.
+    pub peaks: u32,
+    /// Points without a neighbour on a side.
+    pub no_neighbour: u32,
+    /// Left candidate (x′ > 0), compact index.
+    pub left: Option<usize>,
+    /// Right candidate (x′ < 0), compact index.
+    pub right: Option<usize>,
+}
+
+/// Peak search over the smoothed kept points. `aux[k]` holds t(k) − k on entry (from
+/// `bend::right_windows`) and the point's status as `u8` on return ([`PointStatus::Kept`] or
+/// [`PointStatus::NoNeighbour`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn seed_candidates(
+    x: &[f32],
+    z: &[f32],
+    rho: &[f32],
+    aux: &mut [u8],
+    d2: f32,
+    tau_min: f32,
+    tau_max: f32,
+    nadir: Option<usize>,
+    deque: &mut [u16; DEQUE_LEN],
+) -> Seeds {
+    const M: usize = DEQUE_LEN - 1;
+    let n = x.len();
+    let (z, rho, aux) = (&z[..n], &rho[..n], &mut aux[..n]);
+    let mut out = Seeds::default();
+    // Best candidate per side: (index, |k − nadir|, |x|).
+    let mut left: Option<(usize, usize, f32)> = None;
+    let mut right: Option<(usize, usize, f32)> = None;
+    let (mut head, mut tail) = (0usize, 0usize);
+    let mut next = 0usize;
+    let mut s = 0usize;
+    for k in 0..n {
+        s = left_neighbour(x, z, d2, s, k);
+        let t = k + usize::from(aux[k]);
+        while next <= t {
+            let r = rho[next];
+            while tail > head && rho[usize::from(deque[(tail - 1) & M])] <= r {
+                tail -= 1;
+            }
+            // next ≤ k + MAX_SIDE < n ≤ u16::MAX + 1 (the kernel caps N).
+            deque[tail & M] = next as u16;
+            tail += 1;
+            next += 1;
+        }
+        // Never empties: t itself is in the deque or was popped by a later, larger one.
+        while tail > head + 1 && usize::from(deque[head & M]) < s {
+            head += 1;
+        }
+        let max = rho[usize::from(deque[head & M])];
+        if s == k || t == k {
+            aux[k] = PointStatus::NoNeighbour as u8;
+            out.no_neighbour += 1;
+            continue;
+        }
+        aux[k] = PointStatus::Kept as u8;
+        let r = rho[k];
+        if !(r > tau_min && r < tau_max && r >= max) {
+            continue;
+        }
+        out.peaks += 1;
+        let Some(nd) = nadir else { continue };
+        let xk = x[k];
+        let dist = k.abs_diff(nd);
+        let ax = crate::math::abs(xk);
+        let better = |b: Option<(usize, usize, f32)>| match b {
+            None => true,
+            Some((_, bd, bx)) => dist < bd || (dist == bd && ax < bx),
+        };
+        if xk > 0.0 && better(left) {
+            left = Some((k, dist, ax));
+        } else if xk < 0.0 && better(right) {
+            right = Some((k, dist, ax));
+        }
+    }
+    out.left = left.map(|b| b.0);
+    out.right = right.map(|b| b.0);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel::bend::right_windows;
+
+    #[test]
+    fn nadir_is_smallest_abs_x_below_the_scanner() {
+        let x = [3.0f32, 0.2, -0.05, 0.01, -2.0];
+        let z = [-2.0f32, -2.0, -2.0, 1.0, -2.0];
+        // Index 3 has the smallest |x| but is above the scanner.
+        assert_eq!(nadir(&x, &z), Some(2));
+        assert_eq!(nadir(&x[..2], &[1.0, 1.0]), None);
+        assert_eq!(nadir(&[], &[]), None);
+    }
+
+    /// Runs the peak pass on a line with given ρ (windows from positions).
+    fn peaks_of(x: &[f32], rho: &[f32], d2: f32, nadir: Option<usize>) -> (Seeds, [u8; 32]) {
+        let n = x.len();
+        let z = [-2.0f32; 32];
+        let mut aux = [0u8; 32];
+        right_windows(x, &z[..n], d2, &mut aux[..n]);
+        let mut dq = [0u16; DEQUE_LEN];
+        let s = seed_candidates(
+            x,
+            &z[..n],
+            rho,
+            &mut aux[..n],
+            d2,
+            35.0,
+            150.0,
+            nadir,
+            &mut dq,
+        );
+        (s, aux)
+    }
+
+    #[test]
+    fn peaks_are_window_maxima_in_range_and_candidates_are_first_each_side() {
+        // 16 points every 0.05 m from x = −0.4 to 0.35; d_b = 0.1 → 2 points each side.
+        let x: [f32; 16] = core::array::from_fn(|i| -0.4 + 0.05 * i as f32);
+        let mut rho = [0.0f32; 16];
+        rho[1] = 80.0; // peak, right side, 7 steps from nadir 8
+        rho[2] = 50.0; // within the window of 1: not a peak
+        rho[4] = 60.0; // peak, right side, 4 from the nadir → right candidate
+        rho[10] = 40.0; // not a peak: 11 is larger and within d_b
+        rho[11] = 45.0; // peak, left, 3 from the nadir → left candidate
+        rho[14] = 170.0; // above τ_max: not a peak
+                         // End points 0 and 15 have no neighbour on one side.
+        let (s, aux) = peaks_of(&x, &rho, 0.0101, Some(8));
+        assert_eq!(s.peaks, 3);
+        assert_eq!(s.right, Some(4));
+        assert_eq!(s.left, Some(11));
+        assert_eq!(s.no_neighbour, 2);
+        assert_eq!(aux[0], PointStatus::NoNeighbour as u8);
+        assert_eq!(aux[15], PointStatus::NoNeighbour as u8);
+        assert_eq!(aux[7], PointStatus::Kept as u8);
+        // Without a nadir: peaks, but no candidates.
+        let (s, _) = peaks_of(&x, &rho, 0.0101, None);
+        assert_eq!((s.peaks, s.left, s.right), (3, None, None));
+    }
+
+    #[test]
+    fn equal_maxima_are_both_peaks() {
+        let x: [f32; 8] = core::array::from_fn(|i| 0.1 + 0.05 * i as f32);
+        let mut rho = [0.0f32; 8];
+        rho[3] = 90.0;
+        rho[4] = 90.0;
+        let (s, _) = peaks_of(&x, &rho, 0.0101, Some(0));
+        assert_eq!(s.peaks, 2);
+        assert_eq!(s.left, Some(3));
+    }
+}

@@ -1,0 +1,170 @@
+//! CRC-32/ISO-HDLC — the "IEEE" CRC-32 of Ethernet, zlib, PNG and Python's `zlib.crc32`:
+//! reflected polynomial 0xEDB88320 (normal form 0x04C11DB7), initial value and final XOR
+//! 0xFFFFFFFF. Check value of `b"123456789"`: 0xCBF43926.
+//!
+//! Why this CRC and not CRC-32C: the STM32F405's CRC peripheral computes exactly this
+//! polynomial (on 32-bit words, unreflected — with `RBIT` on input and output words it
+//! yields this CRC, and every region the format protects is a multiple of 4 bytes long), and
+//! every host language has it in its standard library, so a stream can be checked with
+//! one line of Python. Error detection for packets of at most [`super::MAX_PACKET_LEN`]
+//! bytes (< 12 000 bits): every burst of up to 32 bits and every 3-bit error is caught
+//! (Hamming distance 4 up to 91 607 bits, Koopman 2002). CRC-32C detects somewhat more on
+//! long packets, but the target has no hardware for it.
+//!
+//! Two software forms, bit-identical (tested): byte-at-a-time with one 256-entry table
+//! (1 KiB of flash — the form for the M4F) and slicing-by-8 (8 KiB of tables, several
+//! times faster on a host CPU; `docs/benchmarks.md`). [`Crc32`] uses slicing-by-8 on
+//! targets with 64-bit pointers and the byte form elsewhere.
+
+/// Reflected CRC-32 polynomial (IEEE 802.3).
+const POLY: u32 = 0xEDB8_8320;
+
+/// The 8 tables of slicing-by-8; `TABLES[0]` is the classic byte-at-a-time table.
+static TABLES: [[u32; 256]; 8] = make_tables();
+
+const fn make_tables() -> [[u32; 256]; 8] {
+    let mut t = [[0u32; 256]; 8];
+    let mut i = 0;
+    while i < 256 {
+        let mut c = i as u32; // i < 256: lossless
+        let mut k = 0;
+        while k < 8 {
+            c = if c & 1 != 0 { (c >> 1) ^ POLY } else { c >> 1 };
+            k += 1;
+        }
+        t[0][i] = c;
+        i += 1;
+    }
+    let mut s = 1;
+    while s < 8 {
+        let mut i = 0;
+        while i < 256 {
+            let prev = t[s - 1][i];
+            t[s][i] = (prev >> 8) ^ t[0][(prev & 0xFF) as usize];
+            i += 1;
+        }
+        s += 1;
+    }
+    t
+}
+
+/// Index of the table entry for the low byte of `x`.
+#[inline(always)]
+fn lo(x: u32) -> usize {
+    usize::from(x.to_le_bytes()[0])
+}
+
+/// Byte-at-a-time update of a raw (pre-inverted) CRC register.
+#[inline]
+fn update_bytewise(mut c: u32, data: &[u8]) -> u32 {
+    for &b in data {
+        c = (c >> 8) ^ TABLES[0][lo(c ^ u32::from(b))];
+    }
+    c
+}
+
+/// Slicing-by-8 update of a raw CRC register (Intel's algorithm, Kounavis & Berry 2005).
+#[inline]
+fn update_slice8(mut c: u32, data: &[u8]) -> u32 {
+    let mut chunks = data.chunks_exact(8);
+    for ch in &mut chunks {
+        let mut w = [0u8; 8];
+        w.copy_from_slice(ch);
+        let a = c ^ u32::from_le_bytes([w[0], w[1], w[2], w[3]]);
+        let b = u32::from_le_bytes([w[4], w[5], w[6], w[7]]);
+        c = TABLES[7][lo(a)]
+            ^ TABLES[6][lo(a >> 8)]
+            ^ TABLES[5][lo(a >> 16)]
+            ^ TABLES[4][lo(a >> 24)]
+            ^ TABLES[3][lo(b)]
+            ^ TABLES[2][lo(b >> 8)]
+            ^ TABLES[1][lo(b >> 16)]
+            ^ TABLES[0][lo(b >> 24)];
+    }
+    update_bytewise(c, chunks.remainder())
+}
+
+/// An incremental CRC-32 (IEEE), so a packet split over the two halves of a ring can be
+/// checked without copying it.
+#[derive(Clone, Copy, Debug)]
+pub struct Crc32 {
+    reg: u32,
+}
+
+impl Crc32 {
+    /// A fresh computation.
+    pub const fn new() -> Self {
+        Self { reg: 0xFFFF_FFFF }
+    }
+
+    /// Feeds `data`.
+    #[inline]
+    pub fn update(&mut self, data: &[u8]) {
+        self.reg = if cfg!(target_pointer_width = "64") {
+            update_slice8(self.reg, data)
+        } else {
+            update_bytewise(self.reg, data)
+        };
+    }
+
+    /// The CRC of everything fed so far.
+    pub fn finish(&self) -> u32 {
+        !self.reg
+    }
+}
+
+impl Default for Crc32 {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// CRC-32 (IEEE) of `data` with the form [`Crc32`] picks for this target.
+pub fn crc32(data: &[u8]) -> u32 {
+    let mut c = Crc32::new();
+    c.update(data);
+    c.finish()
+}
+
+/// CRC-32 (IEEE) of `data`, byte at a time with one 1 KiB table (the M4F form).
+pub fn crc32_bytewise(data: &[u8]) -> u32 {
+    !update_bytewise(0xFFFF_FFFF, data)
+}
+
+/// CRC-32 (IEEE) of `data`, slicing-by-8 (the host form).
+pub fn crc32_slice8(data: &[u8]) -> u32 {
+    !update_slice8(0xFFFF_FFFF, data)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn check_value() {
+        // The catalogue check value of CRC-32/ISO-HDLC.
+        assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
+        assert_eq!(crc32_bytewise(b"123456789"), 0xCBF4_3926);
+        assert_eq!(crc32_slice8(b"123456789"), 0xCBF4_3926);
+        assert_eq!(crc32(b""), 0);
+        // Python: zlib.crc32(b"The quick brown fox jumps over the lazy dog") == 0x414FA339
+        assert_eq!(
+            crc32(b"The quick brown fox jumps over the lazy dog"),
+            0x414F_A339
+        );
+    }
+
+    proptest! {
+        #[test]
+        fn forms_agree_and_split_anywhere(data in proptest::collection::vec(any::<u8>(), 0..300), cut in 0usize..300) {
+            let cut = cut.min(data.len());
+            let a = crc32_bytewise(&data);
+            prop_assert_eq!(a, crc32_slice8(&data));
+            let mut c = Crc32::new();
+            c.update(&data[..cut]);
+            c.update(&data[cut..]);
+            prop_assert_eq!(a, c.finish());
+        }
+    }
+}

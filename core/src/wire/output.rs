@@ -1,0 +1,623 @@
+//! Output packets: one fragment of one scanline's kernel result (core → host, over an
+//! Ethernet-class link). A line of `line_len` points travels as
+//! ⌈line_len / [`MAX_OUTPUT_POINTS_PER_PACKET`]⌉ packets (one empty packet for an empty
+//! line); every fragment repeats the line header, so each packet is self-describing and a
+//! lost fragment loses only its own points.
+//!
+//! Values are scaled integers: x′/z′ in micrometres (`i32`, ±2147 m — at a scanner's
+//! ranges an `f32` itself resolves about 1–8 µm), ρ in centidegrees (`i16`,
+//! −17 999..=18 000 for (−180°, 180°]).
+
+use super::{
+    emit_header, field, get_u16, get_u32, get_u64, get_u8, put_bytes, seal, EncodeError, Error,
+    Packet, PacketKind, CRC_LEN, HEADER_LEN, MAX_OUTPUT_POINTS_PER_PACKET,
+};
+
+/// Length of the per-line header at the start of an output payload.
+pub const OUTPUT_HEADER_LEN: usize = 40;
+/// Length of one output point.
+pub const OUTPUT_POINT_LEN: usize = 16;
+/// The value of an index field meaning "none".
+const NO_INDEX: u16 = 0xFFFF;
+
+/// The per-line part of an output packet (repeated in every fragment).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct OutputHeaderRepr {
+    /// Scanline number in the stream.
+    pub index: u32,
+    /// Absolute time of the line's first point, GPS nanoseconds.
+    pub start_time_ns: u64,
+    /// Hash of the kernel parameters that produced the output.
+    pub params_hash: u32,
+    /// Points of the line dropped by assembly (line over capacity).
+    pub truncated: u32,
+    /// Points in the whole line (all fragments).
+    pub line_len: u16,
+    /// Index within the line of this fragment's first point (the encoder sets it).
+    pub first: u16,
+    /// Index of the nadir point, if any (`< line_len`).
+    pub nadir: Option<u16>,
+    /// Index of the left seed candidate, if any (`< line_len`).
+    pub left: Option<u16>,
+    /// Index of the right seed candidate, if any (`< line_len`).
+    pub right: Option<u16>,
+    /// Kernel counter: points kept.
+    pub kept: u16,
+    /// Kernel counter: points removed as irregular.
+    pub irregular: u16,
+    /// Kernel counter: points without a neighbour on one side.
+    pub no_neighbour: u16,
+    /// Kernel counter: peaks found.
+    pub peaks: u16,
+}
+
+impl OutputHeaderRepr {
+    /// Number of packets the line takes.
+    pub fn fragments(&self) -> usize {
+        usize::from(self.line_len)
+            .div_ceil(MAX_OUTPUT_POINTS_PER_PACKET)
+            .max(1)
+    }
+
+    /// Checks the index fields against `line_len`.
+    fn indices_ok(&self) -> bool {
+        [self.nadir, self.left, self.right]
+            .iter()
+            .all(|i| i.is_none_or(|v| v < self.line_len))
+    }
+}
+
+fn opt_index(v: u16) -> Option<u16> {
+    (v != NO_INDEX).then_some(v)
+}
+
+/// One point of an output packet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct OutputPointRepr {
+    /// The pass-through tag of the input point.
+    pub tag: u32,
+    /// Smoothed x′, micrometres.
+    pub x_um: i32,
+    /// Smoothed z′, micrometres.
+    pub z_um: i32,
+    /// Bend angle ρ, centidegrees, −17 999..=18 000.
+    pub rho_cdeg: i16,
+    /// Point status, opaque to the wire (the kernel's `PointStatus` as `u8`).
+    pub status: u8,
+}
+
+/// Rounds `v · scale` half away from zero into `lo..=hi`; `None` if non-finite or out of
+/// range. f32 multiplication is correctly rounded (IEEE 754), so host and M4F agree.
+fn scale_round(v: f32, scale: f32, lo: i32, hi: i32) -> Option<i32> {
+    if !v.is_finite() {
+        return None;
+    }
+    let s = v * scale;
+    // 2^31 is exact in f32; anything outside (−2^31, 2^31) cannot be an i32.
+    if !(s > -2_147_483_648.0 && s < 2_147_483_648.0) {
+        return None;
+    }
+    // In range, `as` truncates toward zero without saturating; the remainder is exact
+    // (Sterbenz), so the rounding below is exact too.
+    let t = s as i32;
+    let frac = s - t as f32;
+    let r = if frac >= 0.5 {
+        t.checked_add(1)?
+    } else if frac <= -0.5 {
+        t.checked_sub(1)?
+    } else {
+        t
+    };
+    (lo..=hi).contains(&r).then_some(r)
+}
+
+impl OutputPointRepr {
+    /// Builds a point from the kernel's f32 values: x′, z′ in metres (rounded to µm), ρ in
+    /// degrees (rounded to centidegrees; −180.00 becomes +180.00). `index` is reported in
+    /// errors: [`EncodeError::NonFinite`] or [`EncodeError::OutOfRange`] (|x′|, |z′| ≥ 2147 m,
+    /// ρ outside [−180, 180]).
+    pub fn from_f32(
+        tag: u32,
+        x_m: f32,
+        z_m: f32,
+        rho_deg: f32,
+        status: u8,
+        index: usize,
+    ) -> Result<Self, EncodeError> {
+        if !(x_m.is_finite() && z_m.is_finite() && rho_deg.is_finite()) {
+            return Err(EncodeError::NonFinite { index });
+        }
+        let oor = EncodeError::OutOfRange { index };
+        let x_um = scale_round(x_m, 1e6, i32::MIN, i32::MAX).ok_or(oor)?;
+        let z_um = scale_round(z_m, 1e6, i32::MIN, i32::MAX).ok_or(oor)?;
+        let mut rho = scale_round(rho_deg, 100.0, -18_000, 18_000).ok_or(oor)?;
+        if rho == -18_000 {
+            rho = 18_000;
+        }
+        let rho_cdeg = i16::try_from(rho).map_err(|_| oor)?;
+        Ok(Self {
+            tag,
+            x_um,
+            z_um,
+            rho_cdeg,
+            status,
+        })
+    }
+
+    /// x′ in metres.
+    pub fn x_m(&self) -> f64 {
+        f64::from(self.x_um) * 1e-6
+    }
+    /// z′ in metres.
+    pub fn z_m(&self) -> f64 {
+        f64::from(self.z_um) * 1e-6
+    }
+    /// ρ in degrees.
+    pub fn rho_deg(&self) -> f64 {
+        f64::from(self.rho_cdeg) * 1e-2
+    }
+
+    /// Parses one output point from the first [`OUTPUT_POINT_LEN`] bytes of `bytes`
+    /// (offsets in errors are within the record).
+    pub fn parse(bytes: &[u8]) -> Result<Self, Error> {
+        if bytes.len() < OUTPUT_POINT_LEN {
+            return Err(Error::Truncated {
+                needed: OUTPUT_POINT_LEN,
+                available: bytes.len(),
+            });
+        }
+        let rho_cdeg =
+            i16::from_le_bytes(super::get_bytes(bytes, field::out_point::RHO_CDEG.start));
+        if !(-17_999..=18_000).contains(&rho_cdeg) {
+            return Err(Error::OutOfRange {
+                offset: field::out_point::RHO_CDEG.start,
+            });
+        }
+        if get_u8(bytes, field::out_point::RESERVED) != 0 {
+            return Err(Error::ReservedNotZero {
+                offset: field::out_point::RESERVED,
+            });
+        }
+        Ok(Self {
+            tag: get_u32(bytes, field::out_point::TAG),
+            x_um: i32::from_le_bytes(super::get_bytes(bytes, field::out_point::X_UM.start)),
+            z_um: i32::from_le_bytes(super::get_bytes(bytes, field::out_point::Z_UM.start)),
+            rho_cdeg,
+            status: get_u8(bytes, field::out_point::STATUS),
+        })
+    }
+
+    /// Writes the point into the first [`OUTPUT_POINT_LEN`] bytes of `out`.
+    pub fn emit(&self, out: &mut [u8], index: usize) -> Result<(), EncodeError> {
+        if out.len() < OUTPUT_POINT_LEN {
+            return Err(EncodeError::BufferTooSmall {
+                needed: OUTPUT_POINT_LEN,
+                available: out.len(),
+            });
+        }
+        if !(-17_999..=18_000).contains(&self.rho_cdeg) {
+            return Err(EncodeError::OutOfRange { index });
+        }
+        put_bytes(out, field::out_point::TAG.start, &self.tag.to_le_bytes());
+        put_bytes(out, field::out_point::X_UM.start, &self.x_um.to_le_bytes());
+        put_bytes(out, field::out_point::Z_UM.start, &self.z_um.to_le_bytes());
+        put_bytes(
+            out,
+            field::out_point::RHO_CDEG.start,
+            &self.rho_cdeg.to_le_bytes(),
+        );
+        put_bytes(out, field::out_point::STATUS, &[self.status, 0]);
+        Ok(())
+    }
+}
+
+/// Total length of an output packet with `count` points.
+pub const fn output_packet_len(count: usize) -> usize {
+    HEADER_LEN + OUTPUT_HEADER_LEN + count * OUTPUT_POINT_LEN + CRC_LEN
+}
+
+/// The points of a parsed output packet (already validated by [`OutputHeaderRepr::parse`]).
+#[derive(Clone, Debug)]
+pub struct OutputPoints<'a> {
+    rest: core::slice::ChunksExact<'a, u8>,
+}
+
+impl Iterator for OutputPoints<'_> {
+    type Item = OutputPointRepr;
+    fn next(&mut self) -> Option<Self::Item> {
+        // Validated in parse; a failure here cannot happen and ends the iteration.
+        self.rest
+            .next()
+            .and_then(|b| OutputPointRepr::parse(b).ok())
+    }
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        self.rest.size_hint()
+    }
+}
+
+impl ExactSizeIterator for OutputPoints<'_> {}
+
+impl OutputHeaderRepr {
+    /// Parses an output packet (full check: CRC, version, kind, length, header fields and
+    /// every point) and returns its header and its points.
+    pub fn parse<T: AsRef<[u8]>>(packet: &Packet<T>) -> Result<(Self, OutputPoints<'_>), Error> {
+        let kind = packet.check()?;
+        if kind != PacketKind::Output {
+            return Err(Error::WrongKind { kind: kind as u8 });
+        }
+        let b = packet.bytes();
+        use field::out;
+        let h = Self {
+            index: get_u32(b, out::INDEX),
+            start_time_ns: get_u64(b, out::START_TIME),
+            params_hash: get_u32(b, out::PARAMS_HASH),
+            truncated: get_u32(b, out::TRUNCATED),
+            line_len: get_u16(b, out::LINE_LEN),
+            first: get_u16(b, out::FIRST),
+            nadir: opt_index(get_u16(b, out::NADIR)),
+            left: opt_index(get_u16(b, out::LEFT)),
+            right: opt_index(get_u16(b, out::RIGHT)),
+            kept: get_u16(b, out::KEPT),
+            irregular: get_u16(b, out::IRREGULAR),
+            no_neighbour: get_u16(b, out::NO_NEIGHBOUR),
+            peaks: get_u16(b, out::PEAKS),
+        };
+        if get_u16(b, out::RESERVED) != 0 {
+            return Err(Error::ReservedNotZero {
+                offset: out::RESERVED.start,
+            });
+        }
+        if !h.indices_ok() {
+            return Err(Error::OutOfRange {
+                offset: out::NADIR.start,
+            });
+        }
+        let pts = b
+            .get(out::POINTS..b.len().saturating_sub(CRC_LEN))
+            .unwrap_or(&[]);
+        let count = pts.len() / OUTPUT_POINT_LEN;
+        // Canonical fragmentation: fragments start at multiples of the packet capacity,
+        // are full except the last, and only an empty line has an empty packet.
+        let first = usize::from(h.first);
+        let line_len = usize::from(h.line_len);
+        let expected = line_len
+            .saturating_sub(first)
+            .min(MAX_OUTPUT_POINTS_PER_PACKET);
+        if !first.is_multiple_of(MAX_OUTPUT_POINTS_PER_PACKET)
+            || (line_len > 0 && first >= line_len)
+            || (line_len == 0 && first != 0)
+        {
+            return Err(Error::OutOfRange {
+                offset: out::FIRST.start,
+            });
+        }
+        if count != expected {
+            return Err(Error::BadLength {
+                length: packet.length(),
+            });
+        }
+        for (i, rec) in pts.chunks_exact(OUTPUT_POINT_LEN).enumerate() {
+            let at = out::POINTS + i * OUTPUT_POINT_LEN;
+            OutputPointRepr::parse(rec).map_err(|e| match e {
+                Error::OutOfRange { offset } => Error::OutOfRange {
+                    offset: at + offset,
+                },
+                Error::ReservedNotZero { offset } => Error::ReservedNotZero {
+                    offset: at + offset,
+                },
+                other => other,
+            })?;
+        }
+        Ok((
+            h,
+            OutputPoints {
+                rest: pts.chunks_exact(OUTPUT_POINT_LEN),
+            },
+        ))
+    }
+}
+
+/// Writes one output packet: the fragment of `header`'s line that starts at `first` (a
+/// multiple of [`MAX_OUTPUT_POINTS_PER_PACKET`]), taking point `i` of the line from
+/// `point(i)`. Returns the packet length. The body of
+/// [`super::StreamEncoder::encode_output_fragment`].
+pub(super) fn emit_output_fragment(
+    seq: u32,
+    header: &OutputHeaderRepr,
+    first: u16,
+    point: &mut dyn FnMut(usize) -> Result<OutputPointRepr, EncodeError>,
+    out: &mut [u8],
+) -> Result<usize, EncodeError> {
+    let line_len = usize::from(header.line_len);
+    let first_us = usize::from(first);
+    if !header.indices_ok() {
+        return Err(EncodeError::OutOfRange { index: line_len });
+    }
+    if !first_us.is_multiple_of(MAX_OUTPUT_POINTS_PER_PACKET)
+        || (line_len > 0 && first_us >= line_len)
+        || (line_len == 0 && first_us != 0)
+    {
+        return Err(EncodeError::OutOfRange { index: first_us });
+    }
+    let count = (line_len - first_us.min(line_len)).min(MAX_OUTPUT_POINTS_PER_PACKET);
+    let len = output_packet_len(count);
+    if out.len() < len {
+        return Err(EncodeError::BufferTooSmall {
+            needed: len,
+            available: out.len(),
+        });
+    }
+    let len16 = u16::try_from(len).map_err(|_| EncodeError::TooManyPoints {
+        count,
+        max: MAX_OUTPUT_POINTS_PER_PACKET,
+    })?;
+    emit_header(out, PacketKind::Output, len16, seq);
+    use field::out as f;
+    let idx = |v: Option<u16>| v.unwrap_or(NO_INDEX).to_le_bytes();
+    put_bytes(out, f::INDEX.start, &header.index.to_le_bytes());
+    put_bytes(
+        out,
+        f::START_TIME.start,
+        &header.start_time_ns.to_le_bytes(),
+    );
+    put_bytes(out, f::PARAMS_HASH.start, &header.params_hash.to_le_bytes());
+    put_bytes(out, f::TRUNCATED.start, &header.truncated.to_le_bytes());
+    put_bytes(out, f::LINE_LEN.start, &header.line_len.to_le_bytes());
+    put_bytes(out, f::FIRST.start, &first.to_le_bytes());
+    put_bytes(out, f::NADIR.start, &idx(header.nadir));
+    put_bytes(out, f::LEFT.start, &idx(header.left));
+    put_bytes(out, f::RIGHT.start, &idx(header.right));
+    put_bytes(out, f::KEPT.start, &header.kept.to_le_bytes());
+    put_bytes(out, f::IRREGULAR.start, &header.irregular.to_le_bytes());
+    put_bytes(
+        out,
+        f::NO_NEIGHBOUR.start,
+        &header.no_neighbour.to_le_bytes(),
+    );
+    put_bytes(out, f::PEAKS.start, &header.peaks.to_le_bytes());
+    put_bytes(out, f::RESERVED.start, &0u16.to_le_bytes());
+    let recs = out
+        .get_mut(f::POINTS..len - CRC_LEN)
+        .unwrap_or(&mut [])
+        .chunks_exact_mut(OUTPUT_POINT_LEN);
+    for (k, rec) in recs.enumerate() {
+        let i = first_us + k;
+        point(i)?.emit(rec, i)?;
+    }
+    seal(out, len);
+    Ok(len)
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::super::{crc, StreamEncoder, MAX_PACKET_LEN};
+    use super::*;
+    use proptest::prelude::*;
+    use std::{vec, vec::Vec};
+
+    fn arb_point() -> impl Strategy<Value = OutputPointRepr> {
+        (
+            any::<u32>(),
+            any::<i32>(),
+            any::<i32>(),
+            -17_999i16..=18_000,
+            any::<u8>(),
+        )
+            .prop_map(|(tag, x_um, z_um, rho_cdeg, status)| OutputPointRepr {
+                tag,
+                x_um,
+                z_um,
+                rho_cdeg,
+                status,
+            })
+    }
+
+    fn header(line_len: u16) -> OutputHeaderRepr {
+        OutputHeaderRepr {
+            index: 12,
+            start_time_ns: 1_000_000_000,
+            params_hash: 0xDEAD_BEEF,
+            truncated: 0,
+            line_len,
+            first: 0,
+            nadir: line_len.checked_sub(1),
+            left: None,
+            right: Some(0).filter(|_| line_len > 0),
+            kept: line_len,
+            irregular: 0,
+            no_neighbour: 0,
+            peaks: 1,
+        }
+    }
+
+    #[test]
+    fn scaling_rounds_half_away_and_wraps_minus_180() {
+        let p = OutputPointRepr::from_f32(1, 1.2345675, -0.0000005, -180.0, 2, 0).unwrap();
+        assert_eq!(p.x_um, 1_234_568); // f32(1.2345675) * 1e6 = 1234567.5 → away from zero
+        assert_eq!(p.z_um, -1); // −0.5 µm → −1
+        assert_eq!(p.rho_cdeg, 18_000);
+        let p = OutputPointRepr::from_f32(1, -3.0, 0.0, 90.004, 0, 0).unwrap();
+        assert_eq!((p.x_um, p.rho_cdeg), (-3_000_000, 9_000));
+        assert_eq!(
+            OutputPointRepr::from_f32(1, f32::NAN, 0.0, 0.0, 0, 4),
+            Err(EncodeError::NonFinite { index: 4 })
+        );
+        assert_eq!(
+            OutputPointRepr::from_f32(1, 3000.0, 0.0, 0.0, 0, 5),
+            Err(EncodeError::OutOfRange { index: 5 })
+        );
+        assert_eq!(
+            OutputPointRepr::from_f32(1, 0.0, 0.0, 180.01, 0, 6),
+            Err(EncodeError::OutOfRange { index: 6 })
+        );
+    }
+
+    #[test]
+    fn golden_output_packet() {
+        let h = header(1);
+        let p = OutputPointRepr {
+            tag: 7,
+            x_um: 1_500_000,
+            z_um: -2_000_000,
+            rho_cdeg: 9_000,
+            status: 0,
+        };
+        let mut enc = StreamEncoder::with_seq(2);
+        let mut out = [0u8; MAX_PACKET_LEN];
+        let n = enc.encode_output(&h, &[p], &mut out).unwrap();
+        #[rustfmt::skip]
+        let golden: [u8; 72] = [
+            0xA5, 0xC3, 0x01, 0x03, 0x48, 0x00, 0x00, 0x00, 0x02, 0x00, 0x00, 0x00,
+            0x0C, 0x00, 0x00, 0x00, // index 12
+            0x00, 0xCA, 0x9A, 0x3B, 0x00, 0x00, 0x00, 0x00, // start time 1e9 ns
+            0xEF, 0xBE, 0xAD, 0xDE, // params hash
+            0x00, 0x00, 0x00, 0x00, // truncated
+            0x01, 0x00, 0x00, 0x00, // line_len 1, first 0
+            0x00, 0x00, 0xFF, 0xFF, 0x00, 0x00, // nadir 0, left none, right 0
+            0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x01, 0x00, // kept 1, irregular, no_neighbour, peaks 1
+            0x00, 0x00, // reserved
+            0x07, 0x00, 0x00, 0x00, 0x60, 0xE3, 0x16, 0x00, 0x80, 0x7B, 0xE1, 0xFF,
+            0x28, 0x23, 0x00, 0x00, // point
+            0, 0, 0, 0, // CRC, filled below
+        ];
+        let mut golden = golden;
+        let crc = crc::crc32_bytewise(&golden[..68]);
+        golden[68..].copy_from_slice(&crc.to_le_bytes());
+        assert_eq!(&out[..n], &golden[..]);
+        let pk = Packet::new_checked(&golden[..]).unwrap();
+        let (hh, pts) = OutputHeaderRepr::parse(&pk).unwrap();
+        assert_eq!(hh, h);
+        let pts: heapless::Vec<_, 4> = pts.collect();
+        assert_eq!(&pts[..], &[p]);
+        assert_eq!(pts[0].rho_deg(), 90.0);
+    }
+
+    #[test]
+    fn fragmentation_of_a_long_line() {
+        // 2000 points → ⌈2000/88⌉ = 23 packets, the last with 2000 − 22·88 = 64 points.
+        let h = header(2000);
+        let mut enc = StreamEncoder::new();
+        let mut buf = [0u8; 40_000];
+        let n = enc
+            .encode_output_line(
+                &h,
+                |i| {
+                    OutputPointRepr::from_f32(
+                        u32::try_from(i).unwrap(),
+                        i as f32 * 0.01,
+                        -2.0,
+                        0.0,
+                        0,
+                        i,
+                    )
+                },
+                &mut buf,
+            )
+            .unwrap();
+        assert_eq!(MAX_OUTPUT_POINTS_PER_PACKET, 88);
+        assert_eq!(h.fragments(), 23);
+        assert_eq!(n, 22 * output_packet_len(88) + output_packet_len(64));
+        let mut at = 0;
+        let mut next_tag = 0u32;
+        let mut packets = 0;
+        while at < n {
+            let pk = Packet::new_checked(&buf[at..n]).unwrap();
+            assert_eq!(pk.seq(), packets);
+            assert!(pk.length() <= MAX_PACKET_LEN);
+            let (hh, pts) = OutputHeaderRepr::parse(&pk).unwrap();
+            assert_eq!(usize::from(hh.first), usize::try_from(next_tag).unwrap());
+            for p in pts {
+                assert_eq!(p.tag, next_tag);
+                assert_eq!(p.x_um, (next_tag as f32 * 0.01 * 1e6).round() as i32);
+                next_tag += 1;
+            }
+            at += pk.length();
+            packets += 1;
+        }
+        assert_eq!((next_tag, packets), (2000, 23));
+        // An empty line is one packet with no points.
+        let n = enc
+            .encode_output_line(&header(0), |_| unreachable!(), &mut buf)
+            .unwrap();
+        assert_eq!(n, output_packet_len(0));
+        let pk = Packet::new_checked(&buf[..n]).unwrap();
+        let (hh, mut pts) = OutputHeaderRepr::parse(&pk).unwrap();
+        assert_eq!((hh.line_len, pts.next()), (0, None));
+    }
+
+    #[test]
+    fn encoder_rejects_bad_headers() {
+        let mut enc = StreamEncoder::new();
+        let mut buf = [0u8; MAX_PACKET_LEN];
+        let mut h = header(3);
+        h.left = Some(3);
+        assert!(enc
+            .encode_output(&h, &[OutputPointRepr::default(); 3], &mut buf)
+            .is_err());
+        let h = header(3);
+        // Wrong number of points for the fragment.
+        assert!(enc
+            .encode_output(&h, &[OutputPointRepr::default(); 2], &mut buf)
+            .is_err());
+        assert_eq!(
+            enc.seq(),
+            0,
+            "failed encodes do not consume sequence numbers"
+        );
+    }
+
+    proptest! {
+        /// parse ∘ emit is the identity on reprs (every fragment of a random line).
+        #[test]
+        fn output_roundtrip(pts in proptest::collection::vec(arb_point(), 0..300),
+                            index in any::<u32>(), t in any::<u64>(), hash in any::<u32>(),
+                            trunc in any::<u32>(), nadir in any::<u16>(), left in any::<u16>(),
+                            counts in proptest::array::uniform4(any::<u16>())) {
+            let line_len = u16::try_from(pts.len()).unwrap();
+            let pick = |v: u16| if line_len == 0 || v.is_multiple_of(3) { None } else { Some(v % line_len) };
+            let h = OutputHeaderRepr {
+                index, start_time_ns: t, params_hash: hash, truncated: trunc, line_len, first: 0,
+                nadir: pick(nadir), left: pick(left), right: pick(nadir.wrapping_add(left)),
+                kept: counts[0], irregular: counts[1], no_neighbour: counts[2], peaks: counts[3],
+            };
+            let mut enc = StreamEncoder::new();
+            let mut buf = vec![0u8; 8000];
+            let n = enc.encode_output_line(&h, |i| Ok(pts[i]), &mut buf).unwrap();
+            let mut at = 0;
+            let mut got = Vec::new();
+            while at < n {
+                let pk = Packet::new_checked(&buf[at..n]).unwrap();
+                let (hh, ps) = OutputHeaderRepr::parse(&pk).unwrap();
+                prop_assert_eq!(hh, OutputHeaderRepr { first: hh.first, ..h });
+                prop_assert_eq!(usize::from(hh.first), got.len());
+                got.extend(ps);
+                at += pk.length();
+            }
+            prop_assert_eq!(got, pts);
+        }
+
+        /// emit ∘ parse is the identity on canonical bytes.
+        #[test]
+        fn output_canonical(pts in proptest::collection::vec(arb_point(), 1..5), at in 0usize..200, val in any::<u8>()) {
+            let h = header(u16::try_from(pts.len()).unwrap());
+            let mut enc = StreamEncoder::new();
+            let mut b = [0u8; MAX_PACKET_LEN];
+            let n = enc.encode_output(&h, &pts, &mut b).unwrap();
+            let at = at % (n - 4);
+            b[at] = val;
+            let crc = crc::crc32(&b[..n - 4]);
+            b[n - 4..n].copy_from_slice(&crc.to_le_bytes());
+            let pk = Packet::new_unchecked(&b[..n]);
+            if let Ok((hh, ps)) = OutputHeaderRepr::parse(&pk) {
+                let ps: Vec<_> = ps.collect();
+                let mut again = [0u8; MAX_PACKET_LEN];
+                let mut e2 = StreamEncoder::with_seq(pk.seq());
+                let m = e2.encode_output(&hh, &ps, &mut again).unwrap();
+                prop_assert_eq!(&again[..m], &b[..n]);
+            }
+        }
+    }
+}

@@ -1,0 +1,137 @@
+#!/usr/bin/env bash
+# firmware/check.sh STREAM.bin — the firmware against the host, with its budgets.
+#
+# Builds the firmware twice (default libm maths, and micromath), runs each under QEMU's
+# netduinoplus2 board (STM32F405) on STREAM.bin (a `curbtrace replay` byte stream) with the
+# instruction-counting plugin (tools/), runs the host build of the core on the same stream
+# (`curbtrace kernel`), compares the output packets and prints the figures, one
+# `name: value` per line, ending with `identical: yes` or
+# `identical: no (N of M scanlines differ)`. Exits 0 only when the libm firmware's output is
+# byte-identical to the host's and the micromath build agrees with it on the candidates of
+# at least 99 % of the scanlines. Progress goes to stderr, figures to stdout.
+#
+# Needs Debian's rustc-web, cargo-web, rust-web-src, lld-19, qemu-system-arm (scripts/test.sh
+# installs them), gcc, binutils and rustup's stable cargo for the host side.
+# Environment: FIRMWARE_TARGET_DIR (default firmware/target), CARGO_TARGET_DIR (host build,
+# default target/), QEMU_TIMEOUT seconds per QEMU run (default 600), CHECK_KEEP=1 keeps the
+# work directory.
+set -euo pipefail
+
+FW=$(cd "$(dirname "$0")" && pwd)
+ROOT=$(cd "$FW/.." && pwd)
+log() { echo "check.sh: $*" >&2; }
+die() { log "$*"; exit 1; }
+
+[ $# -eq 1 ] || die "usage: firmware/check.sh STREAM.bin"
+[ -f "$1" ] || die "$1: no such file"
+STREAM=$(realpath "$1")
+case "$STREAM" in *[[:space:],]*) die "$STREAM: the path must not contain spaces or commas (QEMU's -semihosting-config splits on them)";; esac
+FW_TARGET=${FIRMWARE_TARGET_DIR:-$FW/target}
+HOST_TARGET=${CARGO_TARGET_DIR:-$ROOT/target}
+QEMU_TIMEOUT=${QEMU_TIMEOUT:-600}
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/curbtrace-fw.XXXXXX")
+if [ "${CHECK_KEEP:-0}" = 1 ]; then log "work directory: $WORK"; else trap 'rm -rf "$WORK"' EXIT; fi
+
+# --- build ----------------------------------------------------------------------------------
+build_fw() { # NAME CARGO-ARGS…: one firmware variant, in its own target dir (no rebuild ping-pong)
+  local name=$1; shift
+  log "building the firmware ($name)"
+  (cd "$FW" && RUSTC_BOOTSTRAP=1 RUSTC=/usr/bin/rustc CARGO_TARGET_DIR="$FW_TARGET/$name" \
+    /usr/bin/cargo build --release --quiet "$@") >&2
+  cp "$FW_TARGET/$name/thumbv7em-none-eabihf/release/curbtrace-firmware" "$WORK/fw-$name.elf"
+}
+build_fw libm
+build_fw micromath --no-default-features --features micromath
+
+log "building the host side (curbtrace, host-check)"
+cargo build --release --quiet --manifest-path "$ROOT/Cargo.toml" -p curbtrace-host-sim --bin curbtrace >&2
+CURBTRACE="$HOST_TARGET/release/curbtrace"
+cargo build --release --quiet --manifest-path "$FW/host-check/Cargo.toml" \
+  --target-dir "$HOST_TARGET/firmware-host-check" >&2
+HOSTCHECK="$HOST_TARGET/firmware-host-check/release/fw-compare"
+
+gcc -O2 -Wall -shared -fPIC -fvisibility=hidden -o "$WORK/libinsncount.so" "$FW/tools/insncount.c"
+
+# --- run ------------------------------------------------------------------------------------
+run_fw() { # NAME: run the firmware under QEMU with the per-stage instruction counter
+  local name=$1 rc=0
+  "$FW/tools/stage-map.sh" "$WORK/fw-$name.elf" "$FW/tools/stages.txt" > "$WORK/$name.map"
+  log "running the firmware ($name) under QEMU"
+  timeout "$QEMU_TIMEOUT" qemu-system-arm -machine netduinoplus2 -nographic \
+    -semihosting-config "enable=on,target=native,arg=fw,arg=$STREAM,arg=$WORK/out-$name.bin" \
+    -plugin "$WORK/libinsncount.so,map=$WORK/$name.map" -d plugin -D "$WORK/counts-$name.log" \
+    -kernel "$WORK/fw-$name.elf" > "$WORK/fw-$name.txt" 2> "$WORK/fw-$name.err" < /dev/null || rc=$?
+  if [ "$rc" -ne 0 ]; then
+    cat "$WORK/fw-$name.txt" "$WORK/fw-$name.err" >&2
+    [ "$rc" -eq 124 ] && die "firmware ($name) did not finish within ${QEMU_TIMEOUT}s"
+    die "firmware ($name) failed (exit status $rc)"
+  fi
+}
+run_fw libm
+run_fw micromath
+
+log "running the host core (curbtrace kernel)"
+"$CURBTRACE" kernel "$STREAM" -o "$WORK/out-host.bin" >&2
+
+# --- figures --------------------------------------------------------------------------------
+fig() { awk -v k="$1" -F': ' '$1 == k { print $2; exit }' "$2"; }   # NAME FILE
+# Section sizes from the ELF: flash = everything loaded into FLASH (vector table, code,
+# read-only data, the initial values of .data); static RAM = .data + .bss + .uninit; the stack
+# is the .stack section (stack.x).
+sizes() { # ELF → "flash static_ram stack"
+  readelf -SW "$1" | awk '
+    { sub(/^ *\[ *[0-9]+\] /, "") }
+    $1 ~ /^\./ && NF >= 7 {
+      name = $1; type = $2; addr = strtonum_hex($3); size = strtonum_hex($5)
+      if (name == ".stack") { stack += size; next }
+      if (addr >= 134217728 && addr < 268435456 && type == "PROGBITS") flash += size
+      if (addr >= 536870912 && addr < 537001984) { ram += size; if (type == "PROGBITS") flash += size }
+    }
+    function strtonum_hex(h,   v, i) {
+      v = 0; h = tolower(h)
+      for (i = 1; i <= length(h); i++) v = v * 16 + index("0123456789abcdef", substr(h, i, 1)) - 1
+      return v
+    }
+    END { printf "%d %d %d\n", flash, ram, stack }'
+}
+per_point() { awk -v n="$1" -v p="$2" 'BEGIN { if (p > 0) printf "%.1f\n", n / p; else print "n/a" }'; }
+stage() { awk -v s="$1" '$1 == "stage" && $2 == s { print $3; f = 1 } END { if (!f) print 0 }' "$2"; }
+total() { sed -n 's/^insns_total=\([0-9]*\).*/\1/p' "$1"; }
+
+read -r flash ram stack < <(sizes "$WORK/fw-libm.elf")
+read -r flash_mm ram_mm _ < <(sizes "$WORK/fw-micromath.elf")
+points=$(fig points_in "$WORK/fw-libm.txt")
+echo "stream: $(basename "$STREAM") ($(stat -c %s "$STREAM") bytes)"
+echo "points: $points"
+echo "scanlines: $(fig lines "$WORK/fw-libm.txt")"
+echo "flash_bytes: $flash (of 1048576)"
+echo "static_ram_bytes: $ram"
+echo "stack_reserved_bytes: $stack"
+echo "ram_total_bytes: $((ram + stack)) (of 131072)"
+echo "stack_high_water_bytes: $(fig stack_high_water_bytes "$WORK/fw-libm.txt")"
+for name in libm micromath; do
+  c="$WORK/counts-$name.log"
+  echo "insns_per_point_$name: $(per_point "$(total "$c")" "$points")"
+  for s in ingest assembly bend smoothing peaks output other; do
+    echo "insns_per_point_${name}_$s: $(per_point "$(stage "$s" "$c")" "$points")"
+  done
+done
+echo "flash_bytes_micromath: $flash_mm"
+echo "static_ram_bytes_micromath: $ram_mm"
+echo "stack_high_water_bytes_micromath: $(fig stack_high_water_bytes "$WORK/fw-micromath.txt")"
+
+"$HOSTCHECK" --approx "$WORK/out-host.bin" "$WORK/out-micromath.bin" > "$WORK/cmp-micromath.txt" ||
+  die "comparing the micromath output failed: $(cat "$WORK/cmp-micromath.txt")"
+sed 's/^/micromath_/' "$WORK/cmp-micromath.txt"
+"$HOSTCHECK" "$WORK/out-host.bin" "$WORK/out-libm.bin" > "$WORK/cmp-libm.txt" ||
+  die "comparing the libm output failed: $(cat "$WORK/cmp-libm.txt")"
+status=0
+agree=$(fig candidates_agree_percent "$WORK/cmp-micromath.txt")
+if ! awk -v a="$agree" 'BEGIN { exit !(a >= 99) }'; then
+  log "micromath candidates agree on only $agree % of the scanlines (need >= 99 %)"
+  status=1
+fi
+identical=$(fig identical "$WORK/cmp-libm.txt")
+echo "identical: $identical"
+[ "$identical" = yes ] || status=1
+exit $status

@@ -1,0 +1,226 @@
+//! A uniform grid over world XY: the spatial index behind the local point set S of §2.7
+//! and the post-filters' neighbourhood queries. Points are bucketed by a counting sort
+//! (two passes, no comparison sort): 4 bytes per point for the sorted indices plus 4
+//! bytes per cell, with the cell grown (never below the requested size) until there are at
+//! most half as many cells as points — about 6 bytes per point in all. A query visits only
+//! the cells the disc touches, never the whole cloud.
+
+/// Point indices bucketed by a square XY cell over the points' bounding box.
+pub struct PointGrid {
+    cell_m: f64,
+    x0: f64,
+    y0: f64,
+    nx: usize,
+    ny: usize,
+    /// `starts[c]..starts[c + 1]` is cell `c`'s range in `order` (`c = cy·nx + cx`).
+    starts: Vec<u32>,
+    /// Point indices, sorted by cell then index.
+    order: Vec<u32>,
+}
+
+impl PointGrid {
+    /// Indexes the points `i` with `keep(i)` true (and finite coordinates), in cells of at
+    /// least `cell_m` metres.
+    pub fn build(x: &[f64], y: &[f64], cell_m: f64, keep: impl Fn(usize) -> bool) -> Self {
+        let n = x.len().min(y.len()).min(u32::MAX as usize - 1);
+        let ok = |i: usize| keep(i) && x[i].is_finite() && y[i].is_finite();
+        let (mut x0, mut y0, mut x1, mut y1) = (
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        );
+        let mut count = 0usize;
+        for i in 0..n {
+            if ok(i) {
+                x0 = x0.min(x[i]);
+                y0 = y0.min(y[i]);
+                x1 = x1.max(x[i]);
+                y1 = y1.max(y[i]);
+                count += 1;
+            }
+        }
+        let mut cell = if cell_m.is_finite() && cell_m > 0.0 {
+            cell_m
+        } else {
+            1.0
+        };
+        if count == 0 {
+            return Self {
+                cell_m: cell,
+                x0: 0.0,
+                y0: 0.0,
+                nx: 0,
+                ny: 0,
+                starts: vec![0],
+                order: Vec::new(),
+            };
+        }
+        let max_cells = (count / 2).max(1024) as f64;
+        let dims = |c: f64| (((x1 - x0) / c).floor() + 1.0, ((y1 - y0) / c).floor() + 1.0);
+        while {
+            let (a, b) = dims(cell);
+            a * b > max_cells
+        } {
+            cell *= 1.5;
+        }
+        let (a, b) = dims(cell);
+        let (nx, ny) = (a as usize, b as usize);
+        let mut g = Self {
+            cell_m: cell,
+            x0,
+            y0,
+            nx,
+            ny,
+            starts: vec![0u32; nx * ny + 1],
+            order: Vec::new(),
+        };
+        for i in 0..n {
+            if ok(i) {
+                let c = g.cell_index(x[i], y[i]);
+                g.starts[c + 1] += 1;
+            }
+        }
+        for c in 0..nx * ny {
+            g.starts[c + 1] += g.starts[c];
+        }
+        let mut fill = g.starts.clone();
+        g.order = vec![0u32; count];
+        for i in 0..n {
+            if ok(i) {
+                let c = g.cell_index(x[i], y[i]);
+                g.order[fill[c] as usize] = i as u32;
+                fill[c] += 1;
+            }
+        }
+        g
+    }
+
+    fn cell_index(&self, x: f64, y: f64) -> usize {
+        let cx = (((x - self.x0) / self.cell_m) as usize).min(self.nx - 1);
+        let cy = (((y - self.y0) / self.cell_m) as usize).min(self.ny - 1);
+        cy * self.nx + cx
+    }
+
+    /// Calls `f(i)` for every indexed point within `r` (horizontal) of `(px, py)`, in a
+    /// fixed order (cells row by row, indices ascending within a cell).
+    pub fn for_each_within(
+        &self,
+        x: &[f64],
+        y: &[f64],
+        px: f64,
+        py: f64,
+        r: f64,
+        mut f: impl FnMut(usize),
+    ) {
+        if self.order.is_empty() || !(px.is_finite() && py.is_finite() && r >= 0.0) {
+            return;
+        }
+        let span = |lo: f64, hi: f64, n: usize| -> Option<(usize, usize)> {
+            let a = (lo / self.cell_m).floor();
+            let b = (hi / self.cell_m).floor();
+            if b < 0.0 || a >= n as f64 {
+                return None;
+            }
+            Some((a.max(0.0) as usize, (b as usize).min(n - 1)))
+        };
+        let Some((ax, bx)) = span(px - r - self.x0, px + r - self.x0, self.nx) else {
+            return;
+        };
+        let Some((ay, by)) = span(py - r - self.y0, py + r - self.y0, self.ny) else {
+            return;
+        };
+        let r2 = r * r;
+        for cy in ay..=by {
+            let row = cy * self.nx;
+            let (lo, hi) = (
+                self.starts[row + ax] as usize,
+                self.starts[row + bx + 1] as usize,
+            );
+            for &i in &self.order[lo..hi] {
+                let i = i as usize;
+                let dx = x[i] - px;
+                let dy = y[i] - py;
+                if dx * dx + dy * dy <= r2 {
+                    f(i);
+                }
+            }
+        }
+    }
+
+    /// Number of indexed points.
+    pub fn len(&self) -> usize {
+        self.order.len()
+    }
+
+    /// Whether no point is indexed.
+    pub fn is_empty(&self) -> bool {
+        self.order.is_empty()
+    }
+
+    /// Cell size in use, metres (at least the one asked for).
+    pub fn cell_m(&self) -> f64 {
+        self.cell_m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn disc_query_matches_brute_force() {
+        // A 20 × 20 lattice at 0.05 m spacing, far from the origin as world data is.
+        let mut x = Vec::new();
+        let mut y = Vec::new();
+        for j in 0..20 {
+            for i in 0..20 {
+                x.push(500_000.0 + i as f64 * 0.05);
+                y.push(4_000_000.0 + j as f64 * 0.05);
+            }
+        }
+        let g = PointGrid::build(&x, &y, 0.1, |i| i % 7 != 3);
+        assert_eq!(g.len(), 400 - 57);
+        let (px, py, r) = (500_000.33, 4_000_000.41, 0.12);
+        let mut got = Vec::new();
+        g.for_each_within(&x, &y, px, py, r, |i| got.push(i));
+        let first = got.clone();
+        got.sort();
+        let want: Vec<usize> = (0..400)
+            .filter(|&i| i % 7 != 3 && (x[i] - px).powi(2) + (y[i] - py).powi(2) <= r * r)
+            .collect();
+        assert_eq!(got, want);
+        assert_eq!(g.cell_m(), 0.1);
+        // The same order on every call.
+        let mut again = Vec::new();
+        g.for_each_within(&x, &y, px, py, r, |i| again.push(i));
+        assert_eq!(again, first);
+        // Points at 0.12 m: a disc of that radius on a 0.05 m lattice holds about
+        // π·0.12²/0.05² ≈ 18 points.
+        assert!((15..=22).contains(&want.len()), "{}", want.len());
+    }
+
+    #[test]
+    fn cells_grow_when_the_box_is_large_and_answers_stay_exact() {
+        // Two clusters 10 km apart: 0.1 m cells would be 10^10 cells.
+        let x = vec![0.0, 0.05, 10_000.0, 10_000.05];
+        let y = vec![0.0, 0.0, 10_000.0, 10_000.0];
+        let g = PointGrid::build(&x, &y, 0.1, |_| true);
+        assert!(g.cell_m() > 100.0);
+        let mut got = Vec::new();
+        g.for_each_within(&x, &y, 10_000.0, 10_000.0, 0.06, |i| got.push(i));
+        assert_eq!(got, vec![2, 3]);
+        got.clear();
+        g.for_each_within(&x, &y, -5.0, 0.0, 1.0, |i| got.push(i));
+        assert!(got.is_empty());
+    }
+
+    #[test]
+    fn empty_grid_answers_nothing() {
+        let g = PointGrid::build(&[], &[], 0.1, |_| true);
+        let mut n = 0;
+        g.for_each_within(&[], &[], 0.0, 0.0, 1.0, |_| n += 1);
+        assert_eq!(n, 0);
+        assert_eq!(g.len(), 0);
+    }
+}

@@ -1,0 +1,184 @@
+//! [`BendParams`]: every parameter of the host half of the bend method (Honma et al.
+//! §2.6–2.7), with defaults. The paper names the parameters but gives no values for any of
+//! them; each field says how its default was chosen.
+
+use serde::{Deserialize, Serialize};
+
+/// Parameters of seeding (§2.6), tracking (§2.7, Eq. 4–8) and the post-filters.
+///
+/// Serialised as a TOML table; every field may be left out (`#[serde(default)]`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BendParams {
+    // ---- Seeding (§2.6) ----
+    /// L_s: length of the intervals along the trajectory that the seed candidates of one
+    /// side are cut into, metres. Not given in the paper; 2 m holds about 18 scanlines at
+    /// 40 km/h (enough for RANSAC) and is short enough that a curb between two driveways
+    /// still gets its own interval.
+    pub seed_interval_m: f64,
+    /// RANSAC iterations per interval. Not in the paper; with 50 % outliers, 64 pairs miss an
+    /// all-inlier pair with probability 0.75^64 ≈ 1e-8. Fewer pairs than this are all tried.
+    pub ransac_iterations: u32,
+    /// RANSAC inlier distance, metres. Not in the paper; candidates on one curb toe scatter
+    /// by the kernel's 1–3 cm point spacing, so 40 mm keeps them and rejects cars and weeds.
+    pub ransac_inlier_m: f64,
+    /// Fewest inliers for an interval to give a seed. Not in the paper; a line through fewer
+    /// than 5 candidates is too easily a coincidence.
+    pub ransac_min_inliers: u32,
+    /// Smallest inlier share for an interval to give a seed. Not in the paper; below one half
+    /// the candidates are mostly not one curb (an intersection or a car), and a seed taken
+    /// there starts a track on the wrong thing.
+    pub ransac_min_inlier_ratio: f64,
+    /// Seed of the RANSAC random generator (ChaCha8), mixed with the side and interval
+    /// number so that every interval draws the same pairs on every run.
+    pub ransac_seed: u64,
+
+    // ---- Tracking (§2.7) ----
+    /// Search distance: how far ahead of the current edge point the search position lies,
+    /// metres (Fig. 7). Not in the paper; a little more than the 0.11 m scanline spacing at
+    /// 40 km/h so that the search set always reaches the next scanline.
+    pub search_distance_m: f64,
+    /// Radius of the local point set S around the search position, horizontal, metres.
+    /// Not in the paper; 0.1 m covers the next one or two scanlines at 20–60 km/h while
+    /// staying narrower than a curb top (so S is not dominated by the sidewalk).
+    pub search_radius_m: f64,
+    /// Half-height of S around the predicted height, metres. Not in the paper (its S is
+    /// horizontal); keeps overhanging branches and car bodies out of S. 0.3 m is above any
+    /// curb step.
+    pub search_half_height_m: f64,
+    /// α, weight of E_b (Eq. 4–5). Not in the paper; 1 (E_b is already normalised by σ_ρ).
+    pub alpha: f64,
+    /// β, weight of E_h (Eq. 4, 6). Not in the paper; chosen so that a point 30° off the
+    /// search direction needs about half a standard deviation more ρ to win.
+    pub beta: f64,
+    /// γ, weight of E_v (Eq. 4, 7). Not in the paper; as β.
+    pub gamma: f64,
+    /// a, weight of the last difference vector in Eq. 8. Not in the paper; a + b = 1, with
+    /// the older vector weighted lower so the direction follows curves with a short lag.
+    pub a: f64,
+    /// b, weight of the difference vector before it in Eq. 8. Not in the paper; see `a`.
+    pub b: f64,
+    /// Bend-angle threshold of the stop rule (§2.7): tracking stops when S holds no point
+    /// with ρ at least this, degrees. Not in the paper; flat road after the kernel's Taubin
+    /// smoothing stays within a few degrees, a 20–30 mm curb cut gives 10–30°.
+    pub stop_rho_deg: f64,
+    /// Smallest σ_ρ used in E_b (Eq. 5), degrees, so that a set S of near-equal ρ does not
+    /// divide by zero. Not in the paper; 1° is below the ρ noise.
+    pub min_sigma_rho_deg: f64,
+    /// Steps the tracker may take across a search set without a point above
+    /// `stop_rho_deg` (extrapolating along the search direction) before it stops. 0 is the
+    /// paper's rule. Not in the paper.
+    pub max_gap_steps: u32,
+    /// Upper bound of steps per track (per direction): a safety net only.
+    pub max_steps: u32,
+    /// Distance, metres, within which a track is taken to have reached another track (it
+    /// stops there and the two are joined when they meet end to end). Not in the paper;
+    /// half the search radius.
+    pub join_distance_m: f64,
+
+    // ---- Post-filters (end of §2.7) ----
+    /// Edges shorter than this are removed, metres. Not in the paper; 1 m is shorter than
+    /// any curb stretch worth mapping and longer than most spurious tracks on cars.
+    pub min_edge_length_m: f64,
+    /// Vehicle filter: lower end of the height band above an edge point, metres. Not in the
+    /// paper; above any curb top and most weeds.
+    pub vehicle_band_low_m: f64,
+    /// Vehicle filter: upper end of the height band, metres. Not in the paper; below street
+    /// trees' crowns, above car roofs' edges.
+    pub vehicle_band_high_m: f64,
+    /// Vehicle filter: horizontal radius around an edge point, metres. Not in the paper; a
+    /// car body overhangs its tyres' contact line by about this much.
+    pub vehicle_radius_m: f64,
+    /// Vehicle filter: an edge is removed when at least this share of its points have points
+    /// in the band above them. Not in the paper; a pole or sign next to a curb covers only a
+    /// few edge points.
+    pub vehicle_share: f64,
+    /// Whether the "outside the roadway" filter runs (§2.7: the segment from an edge's end
+    /// to its nearest trajectory point crosses another edge of the same side).
+    pub roadway_filter: bool,
+
+    // ---- Output ----
+    /// Half-width of the moving average over the output vertices (±k vertices, window
+    /// shrinking symmetrically at the ends so end points stay put). The tracked points are
+    /// measured points, scattered across the toe by the point spacing along the scanline
+    /// (1–3 cm near, up to 14 cm far); averaging 5 of them cuts that scatter by about √5
+    /// while a 4 m corner radius moves by under 2 mm over the 0.45 m window. Not in the
+    /// paper; 0 turns it off.
+    pub smooth_half_window: u32,
+    /// Moves each output vertex to the peak of a parabola through ρ of its point and its
+    /// two neighbours on the same scanline (at most half a point spacing), instead of
+    /// leaving it on the measured point. Not in the paper.
+    pub refine_peak: bool,
+
+    // ---- Curb height and category (output properties) ----
+    /// Width of the strips on either side of an edge point whose median heights give the
+    /// height step, metres (starting `step_gap_m` from the edge).
+    pub step_strip_m: f64,
+    /// Distance from the edge point to the strips, metres (skips the curb face and batter).
+    pub step_gap_m: f64,
+    /// Height steps under this are a curb cut, metres. Curb cuts drop to 20–30 mm, plain
+    /// curbs are 80 mm or more; 50 mm is between.
+    pub curb_cut_max_step_m: f64,
+    /// Edge pieces turning more than this from the trajectory's heading are an
+    /// intersection, degrees. Curbs along the road stay within a few degrees, bus bay tapers
+    /// within about 20°, intersection corners turn to 90°.
+    pub intersection_angle_deg: f64,
+    /// Category runs shorter than this are merged into their neighbours, metres.
+    pub min_category_run_m: f64,
+}
+
+impl Default for BendParams {
+    fn default() -> Self {
+        Self {
+            seed_interval_m: 2.0,
+            ransac_iterations: 64,
+            ransac_inlier_m: 0.04,
+            ransac_min_inliers: 5,
+            ransac_min_inlier_ratio: 0.5,
+            ransac_seed: 0x5eed_c0de,
+            search_distance_m: 0.15,
+            search_radius_m: 0.10,
+            search_half_height_m: 0.3,
+            alpha: 1.0,
+            beta: 3.0,
+            gamma: 1.0,
+            a: 0.7,
+            b: 0.3,
+            stop_rho_deg: 10.0,
+            min_sigma_rho_deg: 1.0,
+            max_gap_steps: 0,
+            max_steps: 200_000,
+            join_distance_m: 0.05,
+            min_edge_length_m: 1.0,
+            vehicle_band_low_m: 0.4,
+            vehicle_band_high_m: 2.0,
+            vehicle_radius_m: 0.2,
+            vehicle_share: 0.3,
+            roadway_filter: true,
+            smooth_half_window: 2,
+            refine_peak: false,
+            step_strip_m: 0.25,
+            step_gap_m: 0.08,
+            curb_cut_max_step_m: 0.05,
+            intersection_angle_deg: 30.0,
+            min_category_run_m: 1.0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn toml_round_trip_and_partial_tables_take_defaults() {
+        let p = BendParams::default();
+        let text = toml::to_string(&p).unwrap();
+        let back: BendParams = toml::from_str(&text).unwrap();
+        assert_eq!(back, p);
+        let partial: BendParams = toml::from_str("search_distance_m = 0.2\n").unwrap();
+        assert_eq!(partial.search_distance_m, 0.2);
+        assert_eq!(partial.seed_interval_m, p.seed_interval_m);
+        assert!(toml::from_str::<BendParams>("no_such_field = 1\n").is_err());
+    }
+}

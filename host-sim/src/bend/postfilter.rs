@@ -1,0 +1,512 @@
+//! Post-filters (end of Honma et al. §2.7) and the output properties of an edge.
+//!
+//! 1. Short edges are removed.
+//! 2. Edges with points in a height band above them are removed: they run along the foot
+//!    of a vehicle (or another object standing on the road), not along a curb.
+//! 3. Edges outside the roadway are removed: if the segment from an end of an edge to its
+//!    nearest trajectory point crosses another edge of the same side, the edge lies behind
+//!    that other edge (e.g. the foot of a wall behind the curb).
+//!
+//! Then each edge gets its height step (median of the per-point steps across it) and a
+//! category per stretch (curb, curb cut by a small step, intersection by turning away
+//! from the trajectory's heading).
+
+use super::grid::PointGrid;
+use super::params::BendParams;
+use super::route::Route;
+use super::track::Track;
+use super::{BendInput, STATUS_NOT_PROCESSED};
+use crate::model::{Category, EdgeLine};
+
+fn pos(input: &BendInput, p: u32) -> [f64; 3] {
+    let i = p as usize;
+    [input.x[i], input.y[i], input.z[i]]
+}
+
+/// Horizontal length of a track, metres.
+pub fn track_length_m(input: &BendInput, t: &Track) -> f64 {
+    t.points
+        .windows(2)
+        .map(|w| {
+            let (a, b) = (pos(input, w[0]), pos(input, w[1]));
+            (b[0] - a[0]).hypot(b[1] - a[1])
+        })
+        .sum()
+}
+
+/// Filter 1: removes tracks shorter than `min_edge_length_m`.
+pub fn remove_short(input: &BendInput, tracks: Vec<Track>, params: &BendParams) -> Vec<Track> {
+    tracks
+        .into_iter()
+        .filter(|t| track_length_m(input, t) >= params.min_edge_length_m)
+        .collect()
+}
+
+/// Share of a track's points that have at least two points of the cloud in the height
+/// band `[vehicle_band_low_m, vehicle_band_high_m]` above them within `vehicle_radius_m`.
+pub fn covered_share(input: &BendInput, grid: &PointGrid, t: &Track, params: &BendParams) -> f64 {
+    if t.points.is_empty() {
+        return 0.0;
+    }
+    let mut covered = 0usize;
+    for &p in &t.points {
+        let q = pos(input, p);
+        let mut n = 0;
+        grid.for_each_within(input.x, input.y, q[0], q[1], params.vehicle_radius_m, |i| {
+            let dz = input.z[i] - q[2];
+            if dz >= params.vehicle_band_low_m && dz <= params.vehicle_band_high_m {
+                n += 1;
+            }
+        });
+        if n >= 2 {
+            covered += 1;
+        }
+    }
+    covered as f64 / t.points.len() as f64
+}
+
+/// Filter 2: removes tracks under vehicles (see [`covered_share`]).
+pub fn remove_under_objects(
+    input: &BendInput,
+    grid: &PointGrid,
+    tracks: Vec<Track>,
+    params: &BendParams,
+) -> Vec<Track> {
+    tracks
+        .into_iter()
+        .filter(|t| covered_share(input, grid, t, params) < params.vehicle_share)
+        .collect()
+}
+
+/// Whether segments ab and cd cross (touching at an end point does not count).
+fn segments_cross(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
+    let orient = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+    };
+    let d1 = orient(c, d, a);
+    let d2 = orient(c, d, b);
+    let d3 = orient(a, b, c);
+    let d4 = orient(a, b, d);
+    ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+}
+
+/// Filter 3: removes tracks one of whose ends sees the trajectory only across another
+/// track of the same side. All tests are made against the tracks as they came in, so
+/// the result does not depend on the order.
+pub fn remove_outside_roadway(input: &BendInput, route: &Route, tracks: Vec<Track>) -> Vec<Track> {
+    let polys: Vec<Vec<[f64; 2]>> = tracks
+        .iter()
+        .map(|t| {
+            t.points
+                .iter()
+                .map(|&p| {
+                    let q = pos(input, p);
+                    [q[0], q[1]]
+                })
+                .collect()
+        })
+        .collect();
+    let outside: Vec<bool> = (0..tracks.len())
+        .map(|k| {
+            let poly = &polys[k];
+            let (Some(&first), Some(&last)) = (poly.first(), poly.last()) else {
+                return false;
+            };
+            [first, last].into_iter().any(|e| {
+                let Some((q, _)) = route.nearest(e[0], e[1]) else {
+                    return false;
+                };
+                (0..tracks.len()).any(|o| {
+                    o != k
+                        && tracks[o].side == tracks[k].side
+                        && polys[o]
+                            .windows(2)
+                            .any(|w| segments_cross(e, q, w[0], w[1]))
+                })
+            })
+        })
+        .collect();
+    tracks
+        .into_iter()
+        .zip(outside)
+        .filter(|(_, out)| !out)
+        .map(|(t, _)| t)
+        .collect()
+}
+
+fn median(v: &mut [f64]) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_unstable_by(|a, b| a.total_cmp(b));
+    let m = v.len() / 2;
+    Some(if v.len() % 2 == 1 {
+        v[m]
+    } else {
+        0.5 * (v[m - 1] + v[m])
+    })
+}
+
+/// Unit tangent of a track at vertex `k`, over the vertices within `half_span_m` of it.
+fn tangent(xy: &[[f64; 2]], k: usize, half_span_m: f64) -> Option<[f64; 2]> {
+    let mut a = k;
+    while a > 0 && (xy[a - 1][0] - xy[k][0]).hypot(xy[a - 1][1] - xy[k][1]) <= half_span_m {
+        a -= 1;
+    }
+    let mut b = k;
+    while b + 1 < xy.len()
+        && (xy[b + 1][0] - xy[k][0]).hypot(xy[b + 1][1] - xy[k][1]) <= half_span_m
+    {
+        b += 1;
+    }
+    if a == b {
+        a = k.saturating_sub(1);
+        b = (k + 1).min(xy.len() - 1);
+    }
+    let d = [xy[b][0] - xy[a][0], xy[b][1] - xy[a][1]];
+    let l = d[0].hypot(d[1]);
+    (l > 1e-9).then(|| [d[0] / l, d[1] / l])
+}
+
+/// Height step across a track at each vertex: median height of the strip outside (away
+/// from the trajectory) minus the median height of the strip inside, metres.
+pub fn height_steps(
+    input: &BendInput,
+    grid: &PointGrid,
+    route: &Route,
+    t: &Track,
+    params: &BendParams,
+) -> Vec<Option<f64>> {
+    let xy: Vec<[f64; 2]> = t
+        .points
+        .iter()
+        .map(|&p| [input.x[p as usize], input.y[p as usize]])
+        .collect();
+    let (g, w) = (params.step_gap_m, params.step_strip_m);
+    let along_max = 0.15;
+    let step_at = |k: usize| -> Option<f64> {
+        let tan = tangent(&xy, k, 0.3)?;
+        let mut nrm = [-tan[1], tan[0]];
+        let (q, _) = route.nearest(xy[k][0], xy[k][1])?;
+        if nrm[0] * (xy[k][0] - q[0]) + nrm[1] * (xy[k][1] - q[1]) < 0.0 {
+            nrm = [-nrm[0], -nrm[1]];
+        }
+        let mut inner = Vec::new();
+        let mut outer = Vec::new();
+        let r = (g + w).hypot(along_max);
+        grid.for_each_within(input.x, input.y, xy[k][0], xy[k][1], r, |i| {
+            if input.status[i] == STATUS_NOT_PROCESSED {
+                return;
+            }
+            let d = [input.x[i] - xy[k][0], input.y[i] - xy[k][1]];
+            let along = d[0] * tan[0] + d[1] * tan[1];
+            let across = d[0] * nrm[0] + d[1] * nrm[1];
+            if along.abs() > along_max {
+                return;
+            }
+            if across >= g && across <= g + w {
+                outer.push(input.z[i]);
+            } else if across <= -g && across >= -g - w {
+                inner.push(input.z[i]);
+            }
+        });
+        Some(median(&mut outer)? - median(&mut inner)?)
+    };
+    // Measured every STEP_SPACING_M along the edge (the strips are 0.3 m long, so closer
+    // samples would mostly repeat each other); vertices in between take the last value.
+    const STEP_SPACING_M: f64 = 0.25;
+    let mut out = Vec::with_capacity(xy.len());
+    let mut last: Option<f64> = None;
+    let mut since = f64::INFINITY;
+    for k in 0..xy.len() {
+        if k > 0 {
+            since += (xy[k][0] - xy[k - 1][0]).hypot(xy[k][1] - xy[k - 1][1]);
+        }
+        if since >= STEP_SPACING_M {
+            last = step_at(k);
+            since = 0.0;
+        }
+        out.push(last);
+    }
+    out
+}
+
+/// Turns tracks into output edges: height steps, categories per stretch (an edge is cut
+/// where its category changes), `method = "bend"`.
+pub fn to_edge_lines(
+    input: &BendInput,
+    grid: &PointGrid,
+    route: &Route,
+    tracks: &[Track],
+    params: &BendParams,
+) -> Vec<EdgeLine> {
+    let mut out = Vec::new();
+    for t in tracks {
+        let raw: Vec<[f64; 3]> = t
+            .points
+            .iter()
+            .map(|&p| {
+                if params.refine_peak {
+                    refined_pos(input, p)
+                } else {
+                    pos(input, p)
+                }
+            })
+            .collect();
+        let xy: Vec<[f64; 2]> = raw.iter().map(|p| [p[0], p[1]]).collect();
+        let xyz = smooth(&raw, params.smooth_half_window as usize);
+        let steps = height_steps(input, grid, route, t, params);
+        let cats: Vec<Category> = (0..xy.len())
+            .map(|k| {
+                let turned = tangent(&xy, k, 0.5)
+                    .zip(route.nearest(xy[k][0], xy[k][1]))
+                    .map(|(tan, (_, f))| {
+                        let c = (tan[0] * f[0] + tan[1] * f[1]).abs().min(1.0);
+                        c.acos().to_degrees() > params.intersection_angle_deg
+                    })
+                    .unwrap_or(false);
+                if turned {
+                    Category::Intersection
+                } else if steps[k].is_some_and(|s| s < params.curb_cut_max_step_m) {
+                    Category::CurbCut
+                } else {
+                    Category::Curb
+                }
+            })
+            .collect();
+        let runs = category_runs(&xy, &cats, params.min_category_run_m);
+        for (a, b, cat) in runs {
+            let mut st: Vec<f64> = steps[a..=b].iter().flatten().copied().collect();
+            out.push(EdgeLine {
+                points: xyz[a..=b].to_vec(),
+                side: t.side,
+                category: Some(cat),
+                method: Some("bend".to_string()),
+                curb_height_m: median(&mut st),
+            });
+        }
+    }
+    out
+}
+
+/// The position of the ρ peak at point `p`: the vertex of the parabola through ρ of `p`
+/// and its neighbours on the same scanline (adjacent in time order), at most half-way to
+/// a neighbour; `p` itself where that is not defined.
+fn refined_pos(input: &BendInput, p: u32) -> [f64; 3] {
+    let i = p as usize;
+    let here = pos(input, p);
+    if i == 0 || i + 1 >= input.x.len() {
+        return here;
+    }
+    let ok =
+        |j: usize| input.status[j] == super::STATUS_KEPT && input.scanline[j] == input.scanline[i];
+    if !(ok(i - 1) && ok(i + 1)) {
+        return here;
+    }
+    let (r0, r1, r2) = (
+        input.rho_deg[i - 1] as f64,
+        input.rho_deg[i] as f64,
+        input.rho_deg[i + 1] as f64,
+    );
+    let denom = r0 - 2.0 * r1 + r2;
+    if denom >= -1e-9 {
+        return here;
+    }
+    let delta = (0.5 * (r0 - r2) / denom).clamp(-0.5, 0.5);
+    let j = if delta > 0.0 { i + 1 } else { i - 1 };
+    let q = pos(input, j as u32);
+    let w = delta.abs();
+    [
+        here[0] + w * (q[0] - here[0]),
+        here[1] + w * (q[1] - here[1]),
+        here[2] + w * (q[2] - here[2]),
+    ]
+}
+
+/// Moving average over ±`k` vertices, the window shrinking symmetrically at the ends.
+fn smooth(p: &[[f64; 3]], k: usize) -> Vec<[f64; 3]> {
+    let n = p.len();
+    (0..n)
+        .map(|i| {
+            let h = k.min(i).min(n - 1 - i);
+            let w = (2 * h + 1) as f64;
+            let mut acc = [0.0; 3];
+            // Sum offsets from p[i], not absolute world coordinates, to keep precision.
+            for q in &p[i - h..=i + h] {
+                for c in 0..3 {
+                    acc[c] += q[c] - p[i][c];
+                }
+            }
+            [
+                p[i][0] + acc[0] / w,
+                p[i][1] + acc[1] / w,
+                p[i][2] + acc[2] / w,
+            ]
+        })
+        .collect()
+}
+
+/// Runs `(first, last, category)` of equal category over the vertices (consecutive runs
+/// share their boundary vertex); runs shorter than `min_run_m` are absorbed by the
+/// neighbour before them (or after, for the first run).
+fn category_runs(
+    xy: &[[f64; 2]],
+    cats: &[Category],
+    min_run_m: f64,
+) -> Vec<(usize, usize, Category)> {
+    if xy.is_empty() {
+        return Vec::new();
+    }
+    let len = |a: usize, b: usize| -> f64 {
+        xy[a..=b]
+            .windows(2)
+            .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+            .sum()
+    };
+    let mut runs: Vec<(usize, usize, Category)> = Vec::new();
+    for (k, &c) in cats.iter().enumerate() {
+        match runs.last_mut() {
+            Some(r) if r.2 == c => r.1 = k,
+            Some(r) => {
+                r.1 = k;
+                runs.push((k, k, c));
+            }
+            None => runs.push((k, k, c)),
+        }
+    }
+    // A run holding only the boundary vertex of a final change: fold it back.
+    if runs.len() > 1 && runs.last().is_some_and(|r| r.0 == r.1) {
+        runs.pop();
+    }
+    // Absorb short runs, shortest first, until every run is long enough or one is left.
+    loop {
+        if runs.len() <= 1 {
+            break;
+        }
+        let Some((k, _)) = runs
+            .iter()
+            .enumerate()
+            .map(|(k, r)| (k, len(r.0, r.1)))
+            .filter(|&(_, l)| l < min_run_m)
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+        else {
+            break;
+        };
+        if k == 0 {
+            runs[1].0 = runs[0].0;
+            runs.remove(0);
+        } else {
+            runs[k - 1].1 = runs[k].1;
+            runs.remove(k);
+        }
+        // Neighbours of equal category become one run.
+        let mut merged: Vec<(usize, usize, Category)> = Vec::new();
+        for r in runs.drain(..) {
+            match merged.last_mut() {
+                Some(m) if m.2 == r.2 => m.1 = r.1,
+                _ => merged.push(r),
+            }
+        }
+        runs = merged;
+    }
+    runs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn crossing_segments() {
+        assert!(segments_cross(
+            [0.0, 0.0],
+            [2.0, 2.0],
+            [0.0, 2.0],
+            [2.0, 0.0]
+        ));
+        assert!(!segments_cross(
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [0.0, 1.0],
+            [1.0, 1.0]
+        ));
+        // Touching at an end point is not a crossing.
+        assert!(!segments_cross(
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [1.0, 0.0],
+            [1.0, 1.0]
+        ));
+    }
+
+    #[test]
+    fn short_category_runs_are_absorbed() {
+        // 21 vertices 0.1 m apart: curb, 3 vertices (0.2–0.3 m) of curb cut, curb.
+        let xy: Vec<[f64; 2]> = (0..21).map(|k| [k as f64 * 0.1, 0.0]).collect();
+        let mut cats = vec![Category::Curb; 21];
+        for c in &mut cats[8..11] {
+            *c = Category::CurbCut;
+        }
+        let runs = category_runs(&xy, &cats, 1.0);
+        assert_eq!(runs, vec![(0, 20, Category::Curb)]);
+        // With a 0.1 m minimum the cut stays, sharing its boundary vertices.
+        let runs = category_runs(&xy, &cats, 0.1);
+        assert_eq!(
+            runs,
+            vec![
+                (0, 8, Category::Curb),
+                (8, 11, Category::CurbCut),
+                (11, 20, Category::Curb)
+            ]
+        );
+    }
+
+    #[test]
+    fn smoothing_averages_inside_and_keeps_the_ends() {
+        let p: Vec<[f64; 3]> = (0..6)
+            .map(|k| [k as f64, if k % 2 == 0 { 0.0 } else { 0.03 }, 1.0])
+            .collect();
+        let s = smooth(&p, 2);
+        assert_eq!(s[0], p[0]);
+        assert_eq!(s[5], p[5]);
+        // Vertex 1: window 0..=2 → y = 0.01; vertex 2: window 0..=4 → y = 0.012.
+        assert!((s[1][1] - 0.01).abs() < 1e-12 && (s[1][0] - 1.0).abs() < 1e-12);
+        assert!((s[2][1] - 0.012).abs() < 1e-12);
+        assert_eq!(smooth(&p, 0), p);
+    }
+
+    #[test]
+    fn peak_refinement_moves_to_the_parabola_vertex() {
+        use crate::io::trajectory::Trajectory;
+        // ρ = 60, 90, 80 at x = 0, 0.02, 0.04: parabola vertex at δ = 0.5·(60 − 80)/
+        // (60 − 180 + 80) = 0.25 points towards the third, x = 0.025.
+        let traj = Trajectory::default();
+        let input = BendInput {
+            x: &[0.0, 0.02, 0.04],
+            y: &[0.0; 3],
+            z: &[1.0; 3],
+            t: &[0.0; 3],
+            rho_deg: &[60.0, 90.0, 80.0],
+            status: &[0; 3],
+            scanline: &[4; 3],
+            candidates: &[],
+            trajectory: &traj,
+        };
+        let q = refined_pos(&input, 1);
+        assert!((q[0] - 0.025).abs() < 1e-12, "{q:?}");
+        // Another scanline next door: no refinement.
+        let input = BendInput {
+            scanline: &[4, 4, 5],
+            ..input
+        };
+        assert_eq!(refined_pos(&input, 1), [0.02, 0.0, 1.0]);
+    }
+
+    #[test]
+    fn median_of_even_and_odd() {
+        assert_eq!(median(&mut [3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(&mut [4.0, 1.0, 2.0, 3.0]), Some(2.5));
+        assert_eq!(median(&mut []), None);
+    }
+}

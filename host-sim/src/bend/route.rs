@@ -1,0 +1,190 @@
+//! The trajectory as a route in the horizontal plane: arc length at a time (for cutting
+//! the seed candidates into intervals of L_s, §2.6), the driving direction at a time, and
+//! the nearest route point to a position (the post-filter of §2.7, categories).
+
+use super::grid::PointGrid;
+use crate::io::trajectory::Trajectory;
+
+/// Horizontal route of the trajectory with cumulative arc length.
+pub struct Route {
+    t: Vec<f64>,
+    x: Vec<f64>,
+    y: Vec<f64>,
+    s: Vec<f64>,
+    heading_deg: Vec<f64>,
+    /// Decimated vertices (indices into the columns above) for nearest-point queries.
+    grid: PointGrid,
+}
+
+/// Spacing of the vertices kept for nearest-point queries, metres.
+const DECIMATE_M: f64 = 0.5;
+
+impl Route {
+    /// Builds the route from the trajectory samples.
+    pub fn new(traj: &Trajectory) -> Self {
+        let n = traj.samples.len();
+        let mut r = Route {
+            t: Vec::with_capacity(n),
+            x: Vec::with_capacity(n),
+            y: Vec::with_capacity(n),
+            s: Vec::with_capacity(n),
+            heading_deg: Vec::with_capacity(n),
+            grid: PointGrid::build(&[], &[], 1.0, |_| true),
+        };
+        let mut s = 0.0;
+        for (k, p) in traj.samples.iter().enumerate() {
+            if k > 0 {
+                s += (p.x - r.x[k - 1]).hypot(p.y - r.y[k - 1]);
+            }
+            r.t.push(p.t);
+            r.x.push(p.x);
+            r.y.push(p.y);
+            r.s.push(s);
+            r.heading_deg.push(p.heading_deg);
+        }
+        // Keep a vertex every DECIMATE_M (and the last one) for the nearest-point index.
+        let mut keep = vec![false; n];
+        let mut last_s = f64::NEG_INFINITY;
+        for (k, kept) in keep.iter_mut().enumerate() {
+            if r.s[k] - last_s >= DECIMATE_M || k + 1 == n {
+                *kept = true;
+                last_s = r.s[k];
+            }
+        }
+        r.grid = PointGrid::build(&r.x, &r.y, 5.0, |k| keep[k]);
+        r
+    }
+
+    fn bracket(&self, t: f64) -> Option<(usize, f64)> {
+        let n = self.t.len();
+        if n == 0 || !t.is_finite() {
+            return None;
+        }
+        if n == 1 {
+            return Some((0, 0.0));
+        }
+        let k = self.t.partition_point(|&u| u <= t).clamp(1, n - 1);
+        let (a, b) = (self.t[k - 1], self.t[k]);
+        let w = if b > a {
+            ((t - a) / (b - a)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        Some((k - 1, w))
+    }
+
+    /// Arc length along the route at time `t`, metres (clamped to the covered range).
+    pub fn arc_at(&self, t: f64) -> Option<f64> {
+        let (k, w) = self.bracket(t)?;
+        let next = (k + 1).min(self.s.len() - 1);
+        Some(self.s[k] + (self.s[next] - self.s[k]) * w)
+    }
+
+    /// Horizontal forward unit vector at time `t` (from the heading, SPEC §2).
+    pub fn forward_at(&self, t: f64) -> Option<[f64; 2]> {
+        let (k, w) = self.bracket(t)?;
+        let next = (k + 1).min(self.s.len() - 1);
+        let h0 = self.heading_deg[k];
+        let mut dh = (self.heading_deg[next] - h0) % 360.0;
+        if dh > 180.0 {
+            dh -= 360.0;
+        } else if dh < -180.0 {
+            dh += 360.0;
+        }
+        let h = (h0 + dh * w).to_radians();
+        Some([h.sin(), h.cos()])
+    }
+
+    /// The nearest point of the route polyline to `(px, py)` and the forward unit vector
+    /// there, or `None` for an empty route.
+    pub fn nearest(&self, px: f64, py: f64) -> Option<([f64; 2], [f64; 2])> {
+        if self.t.is_empty() {
+            return None;
+        }
+        // Nearest kept vertex: widen the disc until it holds one.
+        let mut best: Option<(f64, usize)> = None;
+        let mut r = 10.0;
+        while best.is_none() && r < 1e7 {
+            self.grid.for_each_within(&self.x, &self.y, px, py, r, |k| {
+                let d = (self.x[k] - px).hypot(self.y[k] - py);
+                if best.is_none_or(|(bd, bk)| d < bd || (d == bd && k < bk)) {
+                    best = Some((d, k));
+                }
+            });
+            r *= 4.0;
+        }
+        let (_, k0) = best?;
+        // Refine on the original segments around it (±DECIMATE_M worth of samples).
+        let s0 = self.s[k0];
+        let lo = self
+            .s
+            .partition_point(|&s| s < s0 - 2.0 * DECIMATE_M)
+            .saturating_sub(1);
+        let hi = self
+            .s
+            .partition_point(|&s| s <= s0 + 2.0 * DECIMATE_M)
+            .min(self.s.len() - 1);
+        let mut best_p = ([self.x[k0], self.y[k0]], f64::INFINITY, k0);
+        for k in lo..=hi {
+            let seg_end = (k + 1).min(hi);
+            let (ax, ay) = (self.x[k], self.y[k]);
+            let (bx, by) = (self.x[seg_end], self.y[seg_end]);
+            let (dx, dy) = (bx - ax, by - ay);
+            let l2 = dx * dx + dy * dy;
+            let u = if l2 > 0.0 {
+                (((px - ax) * dx + (py - ay) * dy) / l2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let q = [ax + u * dx, ay + u * dy];
+            let d = (q[0] - px).hypot(q[1] - py);
+            if d < best_p.1 {
+                best_p = (q, d, k);
+            }
+        }
+        let h = self.heading_deg[best_p.2].to_radians();
+        Some((best_p.0, [h.sin(), h.cos()]))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::trajectory::Pose;
+
+    fn east_route() -> Route {
+        // Driving east (heading 90°) at 10 m/s from (1000, 2000), 11 samples.
+        let samples = (0..=10)
+            .map(|k| Pose {
+                t: 100.0 + k as f64,
+                x: 1000.0 + 10.0 * k as f64,
+                y: 2000.0,
+                z: 2.0,
+                roll_deg: 0.0,
+                pitch_deg: 0.0,
+                heading_deg: 90.0,
+            })
+            .collect();
+        Route::new(&Trajectory { samples })
+    }
+
+    #[test]
+    fn arc_length_and_direction_at_a_time() {
+        let r = east_route();
+        assert!((r.arc_at(103.25).unwrap() - 32.5).abs() < 1e-9);
+        assert_eq!(r.arc_at(50.0), Some(0.0));
+        let f = r.forward_at(104.0).unwrap();
+        assert!((f[0] - 1.0).abs() < 1e-12 && f[1].abs() < 1e-12);
+    }
+
+    #[test]
+    fn nearest_point_is_the_foot_of_the_perpendicular() {
+        let r = east_route();
+        let (q, f) = r.nearest(1043.3, 2005.0).unwrap();
+        assert!((q[0] - 1043.3).abs() < 1e-9 && (q[1] - 2000.0).abs() < 1e-9);
+        assert!((f[0] - 1.0).abs() < 1e-12);
+        // Beyond the end: the last sample.
+        let (q, _) = r.nearest(1200.0, 1990.0).unwrap();
+        assert!((q[0] - 1100.0).abs() < 1e-9 && (q[1] - 2000.0).abs() < 1e-9);
+    }
+}

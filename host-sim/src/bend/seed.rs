@@ -1,0 +1,269 @@
+//! Seeding (Honma et al. §2.6): the core's seed candidates are split into left and right,
+//! each side is cut into intervals of L_s along the trajectory, a 2D line is fitted to each
+//! interval by RANSAC, and the candidate closest to the line becomes a seed whose initial
+//! search direction is the line direction oriented with the driving direction. The line's
+//! direction is not constrained, so curbs that are not parallel to the trajectory (bus
+//! bays, intersection corners) still get seeds.
+
+use rand::Rng;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+use super::params::BendParams;
+use super::route::Route;
+use super::BendInput;
+use crate::model::Side;
+
+/// A seed: a candidate point and its initial search direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Seed {
+    /// Index of the seed point in the point columns.
+    pub point: u32,
+    /// Side of the trajectory.
+    pub side: Side,
+    /// Initial search direction (horizontal unit vector, along the driving direction).
+    pub dir: [f64; 2],
+    /// Interval number along the trajectory (for ordering).
+    pub interval: i64,
+    /// Share of the interval's candidates that are RANSAC inliers.
+    pub inlier_ratio: f64,
+}
+
+/// Extracts the seeds of both sides, ordered by side, then interval.
+pub fn seed_points(input: &BendInput, route: &Route, params: &BendParams) -> Vec<Seed> {
+    let n = input.x.len();
+    // (side, interval, point) for every usable candidate, sorted: deterministic whatever
+    // order the candidates came in.
+    let mut keyed: Vec<(Side, i64, u32)> = input
+        .candidates
+        .iter()
+        .filter_map(|c| {
+            let i = c.point as usize;
+            if i >= n || !(input.x[i].is_finite() && input.y[i].is_finite()) {
+                return None;
+            }
+            let s = route.arc_at(*input.t.get(i)?)?;
+            let interval = (s / params.seed_interval_m.max(1e-3)).floor() as i64;
+            Some((c.side, interval, c.point))
+        })
+        .collect();
+    keyed.sort_unstable();
+    keyed.dedup();
+
+    let mut seeds = Vec::new();
+    let mut start = 0;
+    while start < keyed.len() {
+        let (side, interval, _) = keyed[start];
+        let mut end = start;
+        while end < keyed.len() && keyed[end].0 == side && keyed[end].1 == interval {
+            end += 1;
+        }
+        let pts: Vec<u32> = keyed[start..end].iter().map(|k| k.2).collect();
+        let side_bit = matches!(side, Side::Right) as u64;
+        let rng_seed = params.ransac_seed
+            ^ (interval as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+            ^ (side_bit << 63);
+        if let Some(fit) = ransac_line(input.x, input.y, &pts, params, rng_seed) {
+            let i = fit.closest as usize;
+            if let Some(fwd) = route.forward_at(input.t[i]) {
+                let mut dir = fit.dir;
+                if dir[0] * fwd[0] + dir[1] * fwd[1] < 0.0 {
+                    dir = [-dir[0], -dir[1]];
+                }
+                seeds.push(Seed {
+                    point: fit.closest,
+                    side,
+                    dir,
+                    interval,
+                    inlier_ratio: fit.inliers as f64 / pts.len() as f64,
+                });
+            }
+        }
+        start = end;
+    }
+    seeds
+}
+
+/// A RANSAC line fit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LineFit {
+    /// A point on the line (centroid of the inliers).
+    pub origin: [f64; 2],
+    /// Unit direction.
+    pub dir: [f64; 2],
+    /// Number of inliers.
+    pub inliers: usize,
+    /// The inlier closest to the refined line.
+    pub closest: u32,
+}
+
+/// Fits a 2D line to the points `pts` (indices into `x`, `y`) by RANSAC (Fischler and
+/// Bolles 1981): pairs drawn with a ChaCha8 generator seeded by `rng_seed` (all pairs when
+/// there are no more than `ransac_iterations`), the pair with most inliers wins (ties: the
+/// smaller sum of inlier distances, then the earlier draw), then a total-least-squares
+/// refit on its inliers. `None` when too few inliers (`ransac_min_inliers`,
+/// `ransac_min_inlier_ratio`).
+pub fn ransac_line(
+    x: &[f64],
+    y: &[f64],
+    pts: &[u32],
+    params: &BendParams,
+    rng_seed: u64,
+) -> Option<LineFit> {
+    let m = pts.len();
+    if m < 2 || m < params.ransac_min_inliers as usize {
+        return None;
+    }
+    // Local coordinates about the first point: world coordinates are ~1e6 m.
+    let (ox, oy) = (x[pts[0] as usize], y[pts[0] as usize]);
+    let p: Vec<[f64; 2]> = pts
+        .iter()
+        .map(|&i| [x[i as usize] - ox, y[i as usize] - oy])
+        .collect();
+    let eps = params.ransac_inlier_m;
+    let score = |a: [f64; 2], b: [f64; 2]| -> Option<(usize, f64)> {
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let l = dx.hypot(dy);
+        if l < 1e-6 {
+            return None;
+        }
+        let (nx, ny) = (-dy / l, dx / l);
+        let mut count = 0;
+        let mut sum = 0.0;
+        for q in &p {
+            let d = ((q[0] - a[0]) * nx + (q[1] - a[1]) * ny).abs();
+            if d <= eps {
+                count += 1;
+                sum += d;
+            }
+        }
+        Some((count, sum))
+    };
+    let mut best: Option<(usize, f64, usize, usize)> = None;
+    let mut consider = |i: usize, j: usize| {
+        if let Some((c, s)) = score(p[i], p[j]) {
+            if best.is_none_or(|(bc, bs, _, _)| c > bc || (c == bc && s < bs)) {
+                best = Some((c, s, i, j));
+            }
+        }
+    };
+    let pairs = m * (m - 1) / 2;
+    if pairs <= params.ransac_iterations as usize {
+        for i in 0..m {
+            for j in i + 1..m {
+                consider(i, j);
+            }
+        }
+    } else {
+        let mut rng = ChaCha8Rng::seed_from_u64(rng_seed);
+        for _ in 0..params.ransac_iterations {
+            let i = rng.gen_range(0..m);
+            let mut j = rng.gen_range(0..m - 1);
+            if j >= i {
+                j += 1;
+            }
+            consider(i, j);
+        }
+    }
+    let (_, _, bi, bj) = best?;
+    let (a, b) = (p[bi], p[bj]);
+    let l = (b[0] - a[0]).hypot(b[1] - a[1]);
+    let (nx, ny) = (-(b[1] - a[1]) / l, (b[0] - a[0]) / l);
+    let inl: Vec<usize> = (0..m)
+        .filter(|&k| ((p[k][0] - a[0]) * nx + (p[k][1] - a[1]) * ny).abs() <= eps)
+        .collect();
+    if inl.len() < params.ransac_min_inliers as usize
+        || (inl.len() as f64) < params.ransac_min_inlier_ratio * m as f64
+    {
+        return None;
+    }
+    // Total least squares on the inliers: direction of the covariance's major axis.
+    let k = inl.len() as f64;
+    let cx = inl.iter().map(|&i| p[i][0]).sum::<f64>() / k;
+    let cy = inl.iter().map(|&i| p[i][1]).sum::<f64>() / k;
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for &i in &inl {
+        let (dx, dy) = (p[i][0] - cx, p[i][1] - cy);
+        sxx += dx * dx;
+        sxy += dx * dy;
+        syy += dy * dy;
+    }
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let dir = [theta.cos(), theta.sin()];
+    let (nx, ny) = (-dir[1], dir[0]);
+    let closest = inl
+        .iter()
+        .map(|&i| (((p[i][0] - cx) * nx + (p[i][1] - cy) * ny).abs(), i))
+        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+        .map(|(_, i)| pts[i])?;
+    Some(LineFit {
+        origin: [cx + ox, cy + oy],
+        dir,
+        inliers: inl.len(),
+        closest,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 30 points on y = 0.5·x + 3 (x from 0 to 2.9 m, far from the origin), every third
+    /// one moved 0.3–1.2 m off the line.
+    fn line_with_outliers() -> (Vec<f64>, Vec<f64>) {
+        let mut x = Vec::new();
+        let mut y = Vec::new();
+        for k in 0..30 {
+            let xx = k as f64 * 0.1;
+            let off = if k % 3 == 1 {
+                0.3 + 0.03 * k as f64
+            } else {
+                0.0
+            };
+            x.push(600_000.0 + xx);
+            y.push(4_000_000.0 + 0.5 * xx + 3.0 + off);
+        }
+        (x, y)
+    }
+
+    #[test]
+    fn ransac_finds_the_line_through_outliers() {
+        let (x, y) = line_with_outliers();
+        let pts: Vec<u32> = (0..30).collect();
+        let p = BendParams::default();
+        let fit = ransac_line(&x, &y, &pts, &p, 7).unwrap();
+        assert_eq!(fit.inliers, 20);
+        // Slope 0.5: direction (2, 1)/√5 up to sign.
+        let slope = fit.dir[1] / fit.dir[0];
+        assert!((slope - 0.5).abs() < 1e-9, "{slope}");
+        // Every inlier lies on the line, so the closest point is one of them.
+        assert_ne!(fit.closest % 3, 1);
+    }
+
+    #[test]
+    fn ransac_is_deterministic_for_a_seed() {
+        let (x, y) = line_with_outliers();
+        let pts: Vec<u32> = (0..30).collect();
+        let p = BendParams {
+            ransac_iterations: 12,
+            ..BendParams::default()
+        };
+        let a = ransac_line(&x, &y, &pts, &p, 99);
+        let b = ransac_line(&x, &y, &pts, &p, 99);
+        assert_eq!(a, b);
+        assert!(a.is_some());
+    }
+
+    #[test]
+    fn too_few_inliers_give_no_seed() {
+        // Points scattered on a circle of radius 1 m: no three collinear within 40 mm.
+        let x: Vec<f64> = (0..12)
+            .map(|k| (k as f64 * std::f64::consts::FRAC_PI_6).cos())
+            .collect();
+        let y: Vec<f64> = (0..12)
+            .map(|k| (k as f64 * std::f64::consts::FRAC_PI_6).sin())
+            .collect();
+        let pts: Vec<u32> = (0..12).collect();
+        assert_eq!(ransac_line(&x, &y, &pts, &BendParams::default(), 1), None);
+    }
+}

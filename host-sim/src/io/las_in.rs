@@ -1,0 +1,833 @@
+//! LAS/LAZ input as columns (SPEC §3): every point format with GPS time (1, 3, 4, 5, 6–10),
+//! any scale and offset, points in any order (sorted here by time, stably), one scanner
+//! selected, and the file's CRS kept for the output.
+//!
+//! Points are decoded through the `las` crate's byte-slab API (`PointDataBuilder`,
+//! `Reader::fill_points`, column getters) in chunks of [`CHUNK_POINTS`], never as per-point
+//! `Point` structs (TOOLCHAIN.md: 7.3 M/s that way against 65 M/s for the slab).
+//!
+//! # Which points are one scanner
+//!
+//! SPEC §3: "default: all points are one scanner unless the file says otherwise". The rule:
+//!
+//! - Without `--scanner`: in the LAS 1.4 formats 6–10, if the scanner channel (two bits of
+//!   the flags byte) takes more than one value, the file says there are several scanners and
+//!   reading stops with an error listing the channels, so the user picks one. Otherwise
+//!   (legacy formats, or one channel) every point is read. Point source ids are not looked
+//!   at by default: in mobile data they usually number drive lines or strips, not scanners.
+//! - With `--scanner ID`: in formats 6–10 whose scanner channel is not 0 everywhere, ID is
+//!   the scanner channel (0–3); otherwise ID is the point source id.
+//!
+//! # Memory
+//!
+//! Columns: x, y, z, t as `f64` (32 B), intensity `u16` (2 B), scan angle `f32` (4 B):
+//! 38 B per selected point. For uncompressed LAS the header's point count is checked
+//! against the file size before anything is allocated, so the columns are reserved once at
+//! their final size. For LAZ the count cannot be checked that way; the reservation is capped
+//! by the compressed size (see [`laz_reserve_cap`]) and the columns grow only with points
+//! actually decoded. Sorting, when needed, holds a `u32` permutation and one temporary
+//! column (12 B per point) on top.
+
+use crate::model::Crs;
+use las::{PointData, PointDataBuilder, Reader, ReaderOptions};
+use rayon::prelude::*;
+use std::fs::File;
+use std::io::{BufReader, Read};
+use std::path::{Path, PathBuf};
+
+/// Points decoded per `fill_points` call: large enough for LAZ's parallel decoder (chunks of
+/// typically 50 000 points spread over the cores), small enough that the byte slab (at most
+/// 67 B per point for format 10 without extra bytes) stays a few tens of MB.
+pub const CHUNK_POINTS: u64 = 1 << 20;
+
+/// The largest number of points one file may hand to the core: the wire's tag is the `u32`
+/// index into the columns and `u32::MAX` means "not processed" downstream.
+pub const MAX_POINTS: u64 = u32::MAX as u64 - 1;
+
+/// Errors reading a point file. Every message names the file and the problem.
+#[derive(Debug, thiserror::Error)]
+pub enum LasError {
+    /// The file could not be opened or read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The file is zero bytes long.
+    #[error("{path}: empty file (0 bytes), not a LAS/LAZ file")]
+    Empty {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The file does not start with the LAS signature `LASF`.
+    #[error("{path}: not a LAS/LAZ file (no 'LASF' signature at the start)")]
+    NotLas {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The file ends inside the header, the VLRs, or the point records.
+    #[error("{path}: truncated file: {what}")]
+    Truncated {
+        /// The file.
+        path: PathBuf,
+        /// Where it ends and what was expected.
+        what: String,
+    },
+    /// The header's point count and offsets need more bytes than the file has.
+    #[error("{path}: header says {count} points of {record_len} bytes from offset {offset} ({need} bytes), but the file has {size} bytes: truncated or corrupt header")]
+    SizeMismatch {
+        /// The file.
+        path: PathBuf,
+        /// Point count in the header.
+        count: u64,
+        /// Record length in the header.
+        record_len: u16,
+        /// Offset to the point data in the header.
+        offset: u32,
+        /// Bytes the header implies.
+        need: u64,
+        /// Bytes in the file.
+        size: u64,
+    },
+    /// The point format has no GPS time, so points cannot be placed on the trajectory.
+    #[error("{path}: point format {format} has no GPS time; curbtrace needs it to place points on the trajectory (use formats 1, 3, 4, 5 or 6–10)")]
+    NoGpsTime {
+        /// The file.
+        path: PathBuf,
+        /// The point data record format.
+        format: u8,
+    },
+    /// The header says there are no points, or none is left after scanner selection.
+    #[error("{path}: {what}")]
+    NoPoints {
+        /// The file.
+        path: PathBuf,
+        /// Which of the two.
+        what: String,
+    },
+    /// More points than the core's `u32` tags can address.
+    #[error("{path}: {count} points is more than the {max} one run can address; split the file")]
+    TooMany {
+        /// The file.
+        path: PathBuf,
+        /// Point count.
+        count: u64,
+        /// The limit, [`MAX_POINTS`].
+        max: u64,
+    },
+    /// Several scanner channels and no `--scanner`.
+    #[error(
+        "{path}: the file holds points of scanner channels {channels:?}; choose one with --scanner"
+    )]
+    SeveralScanners {
+        /// The file.
+        path: PathBuf,
+        /// The channels present.
+        channels: Vec<u8>,
+    },
+    /// A point has a non-finite GPS time.
+    #[error("{path}: point {index} has GPS time {t}, not a finite number")]
+    BadTime {
+        /// The file.
+        path: PathBuf,
+        /// Index of the point in the file.
+        index: u64,
+        /// The time.
+        t: f64,
+    },
+    /// The `las` crate rejected the header or the point data.
+    #[error("{path}: {what}")]
+    Las {
+        /// The file.
+        path: PathBuf,
+        /// The crate's message with context.
+        what: String,
+    },
+}
+
+/// Which scanner to read.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ReadOptions {
+    /// `--scanner ID`: the scanner channel (formats 6–10 with channels in use) or the point
+    /// source id (see the module docs); `None` reads every point.
+    pub scanner: Option<u16>,
+}
+
+/// How the points were selected (for the summary).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ScannerSelection {
+    /// Every point (no `--scanner`, at most one scanner channel in the file).
+    All,
+    /// Points of one LAS 1.4 scanner channel.
+    Channel(u8),
+    /// Points of one point source id.
+    PointSourceId(u16),
+}
+
+/// What the file's header says, kept beside the columns.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LasInfo {
+    /// The file.
+    pub path: PathBuf,
+    /// LAS version `(major, minor)`.
+    pub version: (u8, u8),
+    /// Point data record format (0–10).
+    pub point_format: u8,
+    /// LAZ-compressed.
+    pub compressed: bool,
+    /// Points in the file (header count).
+    pub points_in_file: u64,
+    /// Points kept after scanner selection (the columns' length).
+    pub points_selected: u64,
+    /// How the points were selected.
+    pub selection: ScannerSelection,
+    /// The file's CRS: EPSG from the GeoTIFF keys, or the WKT VLR; `None` when absent.
+    pub crs: Option<Crs>,
+    /// Whether the points had to be reordered by time.
+    pub was_sorted: bool,
+    /// Whether the scan angle column carries information (not all one value).
+    pub has_scan_angle: bool,
+}
+
+/// The selected points as columns, sorted by GPS time (stable: equal times keep file
+/// order). Index `i` of every column is point `i`, the tag the core carries.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PointColumns {
+    /// World X, LAS CRS, metres.
+    pub x: Vec<f64>,
+    /// World Y, LAS CRS, metres.
+    pub y: Vec<f64>,
+    /// World Z, metres.
+    pub z: Vec<f64>,
+    /// GPS time, seconds, in the file's time base, non-decreasing.
+    pub t: Vec<f64>,
+    /// Intensity as stored.
+    pub intensity: Vec<u16>,
+    /// Scan angle, degrees (legacy formats: whole degrees; 6–10: 0.006° steps).
+    pub scan_angle_deg: Vec<f32>,
+}
+
+impl PointColumns {
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    /// True when there is no point.
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+
+    /// First and last time, or `None` when empty.
+    pub fn time_range(&self) -> Option<(f64, f64)> {
+        Some((*self.t.first()?, *self.t.last()?))
+    }
+
+    fn with_capacity(n: usize) -> Self {
+        Self {
+            x: Vec::with_capacity(n),
+            y: Vec::with_capacity(n),
+            z: Vec::with_capacity(n),
+            t: Vec::with_capacity(n),
+            intensity: Vec::with_capacity(n),
+            scan_angle_deg: Vec::with_capacity(n),
+        }
+    }
+
+    fn shrink_to_fit(&mut self) {
+        self.x.shrink_to_fit();
+        self.y.shrink_to_fit();
+        self.z.shrink_to_fit();
+        self.t.shrink_to_fit();
+        self.intensity.shrink_to_fit();
+        self.scan_angle_deg.shrink_to_fit();
+    }
+
+    /// Keeps the points `range` (the ones the trajectory covers: contiguous, as the columns
+    /// are sorted by time), in place.
+    pub fn keep_range(&mut self, range: std::ops::Range<usize>) {
+        fn go<T>(v: &mut Vec<T>, r: &std::ops::Range<usize>) {
+            v.truncate(r.end);
+            v.drain(..r.start.min(v.len()));
+        }
+        go(&mut self.x, &range);
+        go(&mut self.y, &range);
+        go(&mut self.z, &range);
+        go(&mut self.t, &range);
+        go(&mut self.intensity, &range);
+        go(&mut self.scan_angle_deg, &range);
+    }
+
+    /// Sorts by time, stably, if not sorted already. Returns true when it reordered.
+    fn sort_by_time(&mut self) -> bool {
+        if self.t.windows(2).all(|w| w[0] <= w[1]) {
+            return false;
+        }
+        // Stable sort of a u32 permutation (rayon's par_sort_by is stable); then each
+        // column is gathered through it with one temporary column at a time.
+        let t = &self.t;
+        let mut perm: Vec<u32> = (0..t.len() as u32).collect();
+        perm.par_sort_by(|&a, &b| t[a as usize].total_cmp(&t[b as usize]));
+        fn gather<T: Copy + Send + Sync>(v: &mut Vec<T>, perm: &[u32]) {
+            let out: Vec<T> = perm.par_iter().map(|&i| v[i as usize]).collect();
+            *v = out;
+        }
+        gather(&mut self.x, &perm);
+        gather(&mut self.y, &perm);
+        gather(&mut self.z, &perm);
+        gather(&mut self.t, &perm);
+        gather(&mut self.intensity, &perm);
+        gather(&mut self.scan_angle_deg, &perm);
+        true
+    }
+}
+
+/// Formats whose records carry GPS time.
+pub fn format_has_gps_time(format: u8) -> bool {
+    matches!(format, 1 | 3 | 4 | 5 | 6 | 7 | 8 | 9 | 10)
+}
+
+/// How many points to reserve for a LAZ file of `compressed_bytes` point bytes whose header
+/// claims `count`: a LAZ point takes at least a few bytes in practice (real MLS data 5–15 B),
+/// so more than 4 points per compressed byte is taken as a wrong header and the columns grow
+/// with the points actually decoded instead.
+pub fn laz_reserve_cap(count: u64, compressed_bytes: u64) -> u64 {
+    count.min(compressed_bytes.saturating_mul(4))
+}
+
+/// The fields of the fixed LAS header that the size checks need, parsed from the first 375
+/// bytes (or fewer) without the `las` crate so nothing is allocated from unchecked values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct RawHead {
+    version: (u8, u8),
+    header_size: u16,
+    offset_to_point_data: u32,
+    format: u8,
+    compressed: bool,
+    record_len: u16,
+    count: u64,
+}
+
+fn parse_raw_head(path: &Path, bytes: &[u8], file_size: u64) -> Result<RawHead, LasError> {
+    let path = path.to_path_buf();
+    if file_size == 0 {
+        return Err(LasError::Empty { path });
+    }
+    if bytes.len() < 4 || &bytes[0..4] != b"LASF" {
+        return Err(LasError::NotLas { path });
+    }
+    // LAS 1.0–1.2 headers are 227 bytes; 1.3 235; 1.4 375.
+    if bytes.len() < 227 {
+        return Err(LasError::Truncated {
+            path,
+            what: format!(
+                "the file ends after {} bytes, inside the 227-byte LAS header",
+                bytes.len()
+            ),
+        });
+    }
+    let u16_at = |o: usize| u16::from_le_bytes([bytes[o], bytes[o + 1]]);
+    let u32_at =
+        |o: usize| u32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]);
+    let version = (bytes[24], bytes[25]);
+    let header_size = u16_at(94);
+    let offset_to_point_data = u32_at(96);
+    let format_byte = bytes[104];
+    let record_len = u16_at(105);
+    let legacy_count = u64::from(u32_at(107));
+    let mut count = legacy_count;
+    if version >= (1, 4) {
+        if bytes.len() < 375 {
+            return Err(LasError::Truncated {
+                path,
+                what: format!(
+                    "the file ends after {} bytes, inside the 375-byte LAS 1.4 header",
+                    bytes.len()
+                ),
+            });
+        }
+        let mut b = [0u8; 8];
+        b.copy_from_slice(&bytes[247..255]);
+        let large = u64::from_le_bytes(b);
+        if large > 0 {
+            count = large;
+        }
+    }
+    Ok(RawHead {
+        version,
+        header_size,
+        offset_to_point_data,
+        // LASzip sets bit 7 (and older writers bit 6) of the format byte.
+        format: format_byte & 0x3f,
+        compressed: format_byte & 0xc0 != 0,
+        record_len,
+        count,
+    })
+}
+
+/// The CRS of a header: EPSG from the GeoTIFF projected (else geodetic) key, or the WKT VLR.
+fn header_crs(header: &las::Header) -> Option<Crs> {
+    if let Some(bytes) = header.get_wkt_crs_bytes() {
+        let wkt = String::from_utf8_lossy(bytes)
+            .trim_end_matches('\0')
+            .trim()
+            .to_string();
+        if !wkt.is_empty() {
+            return Some(Crs::Wkt(wkt));
+        }
+    }
+    let gt = header.get_geotiff_crs().ok().flatten()?;
+    let code = gt
+        .get_projected_crs_geo_key_value()
+        .filter(|c| (1024..=32766).contains(c))
+        .or_else(|| {
+            gt.get_geodetic_crs_geo_key_value()
+                .filter(|c| (1024..=32766).contains(c))
+        })?;
+    Some(Crs::Epsg(u32::from(code)))
+}
+
+/// Reads the selected points of a LAS/LAZ file as columns sorted by time.
+///
+/// `progress` is called with (points decoded so far, points in the file) after each chunk.
+pub fn read_points(
+    path: &Path,
+    opts: &ReadOptions,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<(PointColumns, LasInfo), LasError> {
+    let io = |source| LasError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut file = File::open(path).map_err(io)?;
+    let file_size = file.metadata().map_err(io)?.len();
+    let mut head_bytes = Vec::with_capacity(375);
+    (&mut file)
+        .take(375)
+        .read_to_end(&mut head_bytes)
+        .map_err(io)?;
+    let head = parse_raw_head(path, &head_bytes, file_size)?;
+    if !format_has_gps_time(head.format) {
+        return Err(LasError::NoGpsTime {
+            path: path.to_path_buf(),
+            format: head.format,
+        });
+    }
+    if u64::from(head.offset_to_point_data) > file_size
+        || u64::from(head.header_size) > u64::from(head.offset_to_point_data)
+    {
+        return Err(LasError::Truncated {
+            path: path.to_path_buf(),
+            what: format!(
+                "the header puts the point data at byte {} (header {} bytes) but the file has {} bytes",
+                head.offset_to_point_data, head.header_size, file_size
+            ),
+        });
+    }
+    if head.count == 0 {
+        return Err(LasError::NoPoints {
+            path: path.to_path_buf(),
+            what: "the header says the file holds no points".into(),
+        });
+    }
+    let point_bytes = file_size - u64::from(head.offset_to_point_data);
+    let reserve = if head.compressed {
+        laz_reserve_cap(head.count, point_bytes)
+    } else {
+        let need = head.count.saturating_mul(u64::from(head.record_len));
+        if need > point_bytes {
+            return Err(LasError::SizeMismatch {
+                path: path.to_path_buf(),
+                count: head.count,
+                record_len: head.record_len,
+                offset: head.offset_to_point_data,
+                need: need.saturating_add(u64::from(head.offset_to_point_data)),
+                size: file_size,
+            });
+        }
+        head.count
+    };
+    if head.count > MAX_POINTS {
+        return Err(LasError::TooMany {
+            path: path.to_path_buf(),
+            count: head.count,
+            max: MAX_POINTS,
+        });
+    }
+
+    drop(file);
+    let file = File::open(path).map_err(io)?;
+    let las_err = |e: las::Error| las_error(path, e, "reading the header and VLRs");
+    let mut reader = Reader::with_options(
+        BufReader::with_capacity(1 << 20, file),
+        ReaderOptions::default(),
+    )
+    .map_err(las_err)?;
+    let header = reader.header().clone();
+    let crs = header_crs(&header);
+    let total = header.number_of_points();
+    let format = header.point_format();
+    let extended = format.is_extended;
+
+    let mut cols = PointColumns::with_capacity(usize::try_from(reserve).unwrap_or(0));
+    let mut pd: PointData = PointDataBuilder::new().for_header(&header).build();
+    let record_len = pd.record_len();
+    // Scanner channel: bits 4–5 of the flags byte at offset 15 (formats 6–10).
+    let channel_of = |rec: &[u8]| (rec[15] >> 4) & 3;
+    let mut channels_seen = [false; 4];
+    // The selection rule needs to know whether channels are in use before keeping points,
+    // so with `--scanner` on an extended format the first chunk decides: if any point of
+    // the file uses a channel other than 0 the ID is a channel. A file whose first chunk
+    // is all channel 0 but later chunks are not is handled by re-checking at the end.
+    let mut selection: Option<ScannerSelection> = match (opts.scanner, extended) {
+        (None, _) => Some(ScannerSelection::All),
+        (Some(id), false) => Some(ScannerSelection::PointSourceId(id)),
+        (Some(_), true) => None,
+    };
+    let mut done: u64 = 0;
+    let mut first_sa: Option<f32> = None;
+    let mut has_scan_angle = false;
+    loop {
+        let n = reader
+            .fill_points(CHUNK_POINTS, &mut pd)
+            .map_err(|e| las_error(path, e, &format!("decoding points after point {done}")))?;
+        if n == 0 {
+            break;
+        }
+        let raw = pd.raw_bytes();
+        if extended {
+            for rec in raw.chunks_exact(record_len) {
+                channels_seen[usize::from(channel_of(rec))] = true;
+            }
+        }
+        if selection.is_none() {
+            let id = opts.scanner.unwrap_or(0);
+            selection = Some(if channels_seen[1..].iter().any(|&c| c) {
+                ScannerSelection::Channel(u8::try_from(id).ok().filter(|&c| c < 4).ok_or_else(
+                    || LasError::NoPoints {
+                        path: path.to_path_buf(),
+                        what: format!("--scanner {id}: scanner channels are 0–3"),
+                    },
+                )?)
+            } else {
+                ScannerSelection::PointSourceId(id)
+            });
+        }
+        let sel = selection.unwrap_or(ScannerSelection::All);
+        let Some(gps) = pd.gps_time() else {
+            return Err(LasError::NoGpsTime {
+                path: path.to_path_buf(),
+                format: head.format,
+            });
+        };
+        let keep_rec = |rec: &[u8], psid: u16| match sel {
+            ScannerSelection::All => true,
+            ScannerSelection::Channel(c) => channel_of(rec) == c,
+            ScannerSelection::PointSourceId(id) => psid == id,
+        };
+        let iter = raw
+            .chunks_exact(record_len)
+            .zip(pd.point_source_id())
+            .zip(pd.x().zip(pd.y()).zip(pd.z()))
+            .zip(gps.zip(pd.intensity()).zip(pd.scan_angle_degrees()));
+        for (k, (((rec, psid), ((x, y), z)), ((t, i), sa))) in iter.enumerate() {
+            if !keep_rec(rec, psid) {
+                continue;
+            }
+            if !t.is_finite() {
+                return Err(LasError::BadTime {
+                    path: path.to_path_buf(),
+                    index: done + k as u64,
+                    t,
+                });
+            }
+            match first_sa {
+                None => first_sa = Some(sa),
+                Some(f) if f != sa => has_scan_angle = true,
+                _ => {}
+            }
+            cols.x.push(x);
+            cols.y.push(y);
+            cols.z.push(z);
+            cols.t.push(t);
+            cols.intensity.push(i);
+            cols.scan_angle_deg.push(sa);
+        }
+        done += n;
+        progress(done, total);
+        if done >= total {
+            break;
+        }
+    }
+    drop(pd);
+    if done < total {
+        return Err(LasError::Truncated {
+            path: path.to_path_buf(),
+            what: format!("the header says {total} points but only {done} could be decoded"),
+        });
+    }
+    let channels: Vec<u8> = (0u8..4)
+        .filter(|&c| channels_seen[usize::from(c)])
+        .collect();
+    let mut selection = selection.unwrap_or(ScannerSelection::All);
+    if opts.scanner.is_none() && channels.len() > 1 {
+        return Err(LasError::SeveralScanners {
+            path: path.to_path_buf(),
+            channels,
+        });
+    }
+    if let (Some(id), ScannerSelection::PointSourceId(_)) = (opts.scanner, selection) {
+        if extended && channels.iter().any(|&c| c != 0) {
+            // Channels appeared only after the first chunk: the ID meant a channel. Re-read
+            // is avoided by refusing clearly instead of silently mixing the two meanings.
+            return Err(LasError::NoPoints {
+                path: path.to_path_buf(),
+                what: format!(
+                    "--scanner {id}: scanner channels {channels:?} appear only late in the file; cannot tell channel from point source id"
+                ),
+            });
+        }
+        selection = ScannerSelection::PointSourceId(id);
+    }
+    if cols.is_empty() {
+        return Err(LasError::NoPoints {
+            path: path.to_path_buf(),
+            what: match selection {
+                ScannerSelection::All => "no points decoded".into(),
+                ScannerSelection::Channel(c) => {
+                    format!("no point of scanner channel {c} (--scanner {c})")
+                }
+                ScannerSelection::PointSourceId(id) => {
+                    format!("no point with point source id {id} (--scanner {id})")
+                }
+            },
+        });
+    }
+    cols.shrink_to_fit();
+    let was_sorted = !cols.sort_by_time();
+    let info = LasInfo {
+        path: path.to_path_buf(),
+        version: head.version,
+        point_format: head.format,
+        compressed: head.compressed,
+        points_in_file: total,
+        points_selected: cols.len() as u64,
+        selection,
+        crs,
+        was_sorted,
+        has_scan_angle,
+    };
+    Ok((cols, info))
+}
+
+/// Maps a `las` crate error to a one-line message naming the file, the stage, and whether
+/// the file looks truncated.
+fn las_error(path: &Path, e: las::Error, stage: &str) -> LasError {
+    // Walk the cause chain: an unexpected end of file anywhere in it (LAS read_exact, or
+    // the LAZ decoder's reader) means the file is shorter than its header says.
+    let mut truncated = false;
+    let mut cause: Option<&(dyn std::error::Error + 'static)> = Some(&e);
+    while let Some(c) = cause {
+        if let Some(io) = c.downcast_ref::<std::io::Error>() {
+            truncated |= io.kind() == std::io::ErrorKind::UnexpectedEof;
+        }
+        cause = c.source();
+    }
+    // The LAZ decoder flattens its io::Error into its own type without a source.
+    let text = e.to_string();
+    truncated |= text.contains("failed to fill whole buffer") || text.contains("UnexpectedEof");
+    if truncated {
+        LasError::Truncated {
+            path: path.to_path_buf(),
+            what: format!("unexpected end of file while {stage}"),
+        }
+    } else {
+        LasError::Las {
+            path: path.to_path_buf(),
+            what: format!("{stage}: {e}"),
+        }
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use las::{Builder, Point, Writer};
+
+    /// Writes `points` to `path` in `format` (LAZ when the path ends in .laz).
+    pub(crate) fn write_las(path: &Path, format: u8, points: &[Point], epsg: Option<u16>) {
+        let mut b = Builder::from((1, 4));
+        b.point_format = las::point::Format::new(format).unwrap();
+        b.point_format.is_compressed = path.extension().is_some_and(|e| e == "laz");
+        b.transforms = las::Vector {
+            x: las::Transform {
+                scale: 0.001,
+                offset: 500_000.0,
+            },
+            y: las::Transform {
+                scale: 0.001,
+                offset: 4_000_000.0,
+            },
+            z: las::Transform {
+                scale: 0.001,
+                offset: 0.0,
+            },
+        };
+        if let Some(code) = epsg {
+            b.vlrs.push(geokey_vlr(code));
+        }
+        let header = b.into_header().unwrap();
+        let mut w = Writer::from_path(path, header).unwrap();
+        for p in points {
+            w.write_point(p.clone()).unwrap();
+        }
+        w.close().unwrap();
+    }
+
+    /// A GeoKeyDirectory VLR with ProjectedCRSGeoKey (3072) = `code`.
+    fn geokey_vlr(code: u16) -> las::Vlr {
+        let words: [u16; 8] = [1, 1, 0, 1, 3072, 0, 1, code];
+        let data = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+        las::Vlr {
+            user_id: "LASF_Projection".into(),
+            record_id: 34735,
+            description: "GeoKeyDirectoryTag".into(),
+            data,
+        }
+    }
+
+    pub(crate) fn pt(x: f64, y: f64, z: f64, t: f64) -> Point {
+        Point {
+            x,
+            y,
+            z,
+            gps_time: Some(t),
+            intensity: 7,
+            ..Default::default()
+        }
+    }
+
+    fn read(path: &Path, scanner: Option<u16>) -> Result<(PointColumns, LasInfo), LasError> {
+        read_points(path, &ReadOptions { scanner }, &mut |_, _| {})
+    }
+
+    #[test]
+    fn reads_columns_sorted_by_time_with_crs() {
+        let dir = tempfile::tempdir().unwrap();
+        for name in ["a.las", "a.laz"] {
+            let path = dir.path().join(name);
+            let pts = vec![
+                pt(500_001.0, 4_000_002.0, 3.0, 10.5),
+                pt(500_004.0, 4_000_005.0, 6.0, 10.25),
+                pt(500_007.125, 4_000_008.0, 9.0, 10.5),
+            ];
+            write_las(&path, 6, &pts, Some(6677));
+            let (c, info) = read(&path, None).unwrap();
+            assert_eq!(c.t, vec![10.25, 10.5, 10.5]);
+            // Stable: the two points at 10.5 keep file order.
+            assert_eq!(c.x, vec![500_004.0, 500_001.0, 500_007.125]);
+            assert_eq!(c.z, vec![6.0, 3.0, 9.0]);
+            assert_eq!(c.intensity, vec![7, 7, 7]);
+            assert_eq!(info.crs, Some(Crs::Epsg(6677)));
+            assert!(!info.was_sorted);
+            assert_eq!(info.point_format, 6);
+            assert_eq!(info.compressed, name.ends_with("laz"));
+            assert_eq!(info.points_selected, 3);
+        }
+    }
+
+    #[test]
+    fn every_format_with_gps_time_reads() {
+        let dir = tempfile::tempdir().unwrap();
+        for f in [1u8, 3, 4, 5, 6, 7, 8, 9, 10] {
+            let path = dir.path().join(format!("f{f}.las"));
+            let mut p = pt(500_000.5, 4_000_000.25, 1.0, 5.0);
+            let fmt = las::point::Format::new(f).unwrap();
+            if fmt.has_color {
+                p.color = Some(las::Color::new(1, 2, 3));
+            }
+            if fmt.has_nir {
+                p.nir = Some(4);
+            }
+            if fmt.has_waveform {
+                p.waveform = Some(Default::default());
+            }
+            p.scan_angle = 12.0;
+            write_las(&path, f, &[p], None);
+            let (c, info) = read(&path, None).unwrap();
+            assert_eq!(
+                (c.x[0], c.y[0], c.t[0]),
+                (500_000.5, 4_000_000.25, 5.0),
+                "format {f}"
+            );
+            assert!((c.scan_angle_deg[0] - 12.0).abs() < 0.01, "format {f}");
+            assert_eq!(info.point_format, f);
+            assert_eq!(info.crs, None);
+        }
+    }
+
+    #[test]
+    fn scanner_channel_and_point_source_selection() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("two.las");
+        let mut pts = Vec::new();
+        for k in 0..6 {
+            let mut p = pt(500_000.0 + k as f64, 4_000_000.0, 0.0, k as f64);
+            p.scanner_channel = (k % 2) as u8;
+            p.point_source_id = 40 + (k % 3) as u16;
+            pts.push(p);
+        }
+        write_las(&path, 6, &pts, None);
+        let err = read(&path, None).unwrap_err().to_string();
+        assert!(
+            err.contains("two.las") && err.contains("[0, 1]") && err.contains("--scanner"),
+            "{err}"
+        );
+        let (c, info) = read(&path, Some(1)).unwrap();
+        assert_eq!(c.t, vec![1.0, 3.0, 5.0]);
+        assert_eq!(info.selection, ScannerSelection::Channel(1));
+
+        // Format 1 has no scanner channel: the ID is the point source id.
+        let path = dir.path().join("psid.las");
+        for p in &mut pts {
+            p.scanner_channel = 0;
+        }
+        write_las(&path, 1, &pts, None);
+        let (c, info) = read(&path, Some(41)).unwrap();
+        assert_eq!(c.t, vec![1.0, 4.0]);
+        assert_eq!(info.selection, ScannerSelection::PointSourceId(41));
+        assert_eq!(info.points_in_file, 6);
+        let err = read(&path, Some(7)).unwrap_err().to_string();
+        assert!(err.contains("point source id 7"), "{err}");
+    }
+
+    #[test]
+    fn raw_head_parses_sizes() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("h.las");
+        write_las(
+            &path,
+            1,
+            &vec![pt(500_000.0, 4_000_000.0, 0.0, 1.0); 3],
+            None,
+        );
+        let bytes = std::fs::read(&path).unwrap();
+        let h = parse_raw_head(&path, &bytes[..375], bytes.len() as u64).unwrap();
+        assert_eq!(h.format, 1);
+        assert_eq!(h.record_len, 28);
+        assert_eq!(h.count, 3);
+        assert!(!h.compressed);
+        assert_eq!(
+            u64::from(h.offset_to_point_data) + 3 * 28,
+            bytes.len() as u64
+        );
+    }
+
+    #[test]
+    fn laz_reservation_is_capped_by_the_compressed_size() {
+        assert_eq!(laz_reserve_cap(1_000_000_000_000, 1000), 4000);
+        assert_eq!(laz_reserve_cap(10, 1000), 10);
+    }
+}

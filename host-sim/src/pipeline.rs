@@ -1,0 +1,384 @@
+//! The whole job of `curbtrace extract` as a library call (the demo and the tests call it):
+//! read the points (columns, sorted by time) and the trajectory, drop and count the points
+//! outside the trajectory, replay the rest through the core in-process, then seed, track
+//! and filter edges (Honma et al. §2.6–2.7) from the core's output as it is.
+
+use crate::bend::{self, BendInput};
+use crate::config::{Config, ConfigError};
+use crate::io::las_in::{self, LasError, LasInfo, PointColumns, ReadOptions};
+use crate::io::trajectory::{Trajectory, TrajectoryError};
+use crate::model::{Crs, EdgeLine};
+use crate::replay::run::{self, KernelResults, ReplayCounters, ReplayError};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Errors of the whole extraction; every message names the file and the problem.
+#[derive(Debug, thiserror::Error)]
+pub enum ExtractError {
+    /// Reading the point file.
+    #[error(transparent)]
+    Las(#[from] LasError),
+    /// Reading the trajectory or matching it to the points.
+    #[error(transparent)]
+    Trajectory(#[from] TrajectoryError),
+    /// The config file.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// Replaying through the core.
+    #[error("{path}: replay through the core: {source}")]
+    Replay {
+        /// The point file.
+        path: PathBuf,
+        /// The cause.
+        source: ReplayError,
+    },
+    /// A method that is not part of this build.
+    #[error("method {0:?} is not available in this build")]
+    Method(String),
+}
+
+/// Which method extracts the edges.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Method {
+    /// The bend-angle method (Honma et al.), through the core.
+    #[default]
+    Bend,
+    /// The plane-based method (Qiu et al.).
+    Qiu,
+}
+
+impl Method {
+    /// The spelling in the output's `method` property.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Method::Bend => "bend",
+            Method::Qiu => "qiu",
+        }
+    }
+}
+
+/// Options of one run that are not parameters of a method.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ExtractOptions {
+    /// `--scanner ID` (see `io::las_in`).
+    pub scanner: Option<u16>,
+    /// `--method`.
+    pub method: Method,
+}
+
+/// A progress display the library can drive (hidden unless the CLI makes a visible one).
+#[derive(Clone, Debug, Default)]
+pub struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl Progress {
+    /// No display.
+    pub fn hidden() -> Self {
+        Self { bar: None }
+    }
+
+    /// A bar on stderr (the CLI creates it only when stderr is a terminal).
+    pub fn bar() -> Self {
+        let bar = indicatif::ProgressBar::new(0);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{msg:>10} [{bar:40}] {human_pos}/{human_len} points ({per_sec}, {eta})",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        Self { bar: Some(bar) }
+    }
+
+    /// Starts a stage of `total` points.
+    pub fn stage(&self, name: &'static str, total: u64) {
+        if let Some(b) = &self.bar {
+            b.set_message(name);
+            b.set_length(total);
+            b.set_position(0);
+        }
+    }
+
+    /// Points done in the current stage.
+    pub fn set(&self, done: u64) {
+        if let Some(b) = &self.bar {
+            b.set_position(done);
+        }
+    }
+
+    /// Removes the bar.
+    pub fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
+
+/// Wall time per stage, seconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StageTimes {
+    /// Reading the point file (decode, select, sort).
+    pub read_s: f64,
+    /// Reading the trajectory and the coverage check.
+    pub trajectory_s: f64,
+    /// Projection, encoding and the core.
+    pub core_s: f64,
+    /// Seeding, tracking, post-filters.
+    pub edges_s: f64,
+    /// Everything.
+    pub total_s: f64,
+}
+
+/// What the summary at the end reports.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Summary {
+    /// The point file's header information.
+    pub las: LasInfo,
+    /// Points before the trajectory's first time (dropped).
+    pub dropped_before_trajectory: u64,
+    /// Points after the trajectory's last time (dropped).
+    pub dropped_after_trajectory: u64,
+    /// The core's counters.
+    pub core: ReplayCounters,
+    /// Seed candidates from the core.
+    pub candidates: u64,
+    /// Edges extracted.
+    pub edges: u64,
+    /// Their total horizontal length, metres.
+    pub total_length_m: f64,
+    /// Time per stage.
+    pub times: StageTimes,
+}
+
+impl Summary {
+    /// Points read from the file (after scanner selection).
+    pub fn points_read(&self) -> u64 {
+        self.las.points_selected
+    }
+
+    /// The summary as a few lines of text.
+    pub fn to_text(&self) -> String {
+        let c = &self.core;
+        let pts_per_s = self.points_read() as f64 / self.times.total_s.max(1e-9);
+        format!(
+            "points read        {read} of {file} in {path}\n\
+             dropped            {before} before and {after} after the trajectory, {trunc} in over-long lines, {lost} lost in the core, {irr} irregular (§2.4), {nn} without neighbours\n\
+             scanlines          {lines}\n\
+             candidates         {cand}\n\
+             edges              {edges}, total length {len:.1} m\n\
+             time               {total:.2} s ({pts:.2} M points/s): read {r:.2} s, trajectory {t:.2} s, core {k:.2} s, edges {e:.2} s",
+            read = self.points_read(),
+            file = self.las.points_in_file,
+            path = self.las.path.display(),
+            before = self.dropped_before_trajectory,
+            after = self.dropped_after_trajectory,
+            trunc = c.truncated,
+            lost = c.lost,
+            irr = c.irregular,
+            nn = c.no_neighbour,
+            lines = c.scanlines,
+            cand = self.candidates,
+            edges = self.edges,
+            len = self.total_length_m,
+            total = self.times.total_s,
+            pts = pts_per_s / 1e6,
+            r = self.times.read_s,
+            t = self.times.trajectory_s,
+            k = self.times.core_s,
+            e = self.times.edges_s,
+        )
+    }
+}
+
+/// The result of [`extract_file`].
+#[derive(Clone, Debug)]
+pub struct ExtractResult {
+    /// The edges, in the LAS CRS.
+    pub edges: Vec<EdgeLine>,
+    /// The LAS file's CRS, for the output.
+    pub crs: Option<Crs>,
+    /// The summary.
+    pub summary: Summary,
+}
+
+/// The points and the core's results, before any method runs (shared by `extract`,
+/// `replay`-style tools and the demo).
+pub struct Replayed {
+    /// The covered points, sorted by time.
+    pub columns: PointColumns,
+    /// Header information.
+    pub las: LasInfo,
+    /// The trajectory.
+    pub trajectory: Trajectory,
+    /// Points dropped before / after the trajectory.
+    pub dropped: (u64, u64),
+    /// The core's output per point.
+    pub kernel: KernelResults,
+    /// Stage times so far.
+    pub times: StageTimes,
+}
+
+/// Reads the points and the trajectory and drops (and counts) the points outside it.
+pub fn load(
+    points: &Path,
+    traj_path: &Path,
+    opts: &ExtractOptions,
+    progress: &Progress,
+) -> Result<(PointColumns, LasInfo, Trajectory, (u64, u64), StageTimes), ExtractError> {
+    let mut times = StageTimes::default();
+    // The trajectory first: a bad trajectory fails in milliseconds, not after decoding.
+    let t0 = Instant::now();
+    let trajectory = Trajectory::read_csv(traj_path)?;
+    times.trajectory_s = t0.elapsed().as_secs_f64();
+    let t0 = Instant::now();
+    progress.stage("reading", 0);
+    let (mut cols, las) = las_in::read_points(
+        points,
+        &ReadOptions {
+            scanner: opts.scanner,
+        },
+        &mut |done, total| {
+            progress.stage("reading", total);
+            progress.set(done);
+        },
+    )?;
+    times.read_s = t0.elapsed().as_secs_f64();
+    let t0 = Instant::now();
+    let cov = trajectory.coverage(&cols.t, traj_path, points)?;
+    if cov.dropped() > 0 {
+        cols.keep_range(cov.start..cov.end);
+    }
+    times.trajectory_s += t0.elapsed().as_secs_f64();
+    Ok((
+        cols,
+        las,
+        trajectory,
+        (cov.before as u64, cov.after as u64),
+        times,
+    ))
+}
+
+/// [`load`], then the replay through the core.
+pub fn replay_file(
+    points: &Path,
+    traj_path: &Path,
+    cfg: &Config,
+    opts: &ExtractOptions,
+    progress: &Progress,
+) -> Result<Replayed, ExtractError> {
+    let (columns, las, trajectory, dropped, mut times) = load(points, traj_path, opts, progress)?;
+    let words = cfg.kernel_words().map_err(|what| ConfigError::Kernel {
+        path: PathBuf::from("(config)"),
+        what,
+    })?;
+    let t0 = Instant::now();
+    progress.stage("core", columns.len() as u64);
+    let kernel = run::run_kernel(&columns, &trajectory, &words, &cfg.replay, &|d| {
+        progress.set(d)
+    })
+    .map_err(|source| ExtractError::Replay {
+        path: points.to_path_buf(),
+        source,
+    })?;
+    times.core_s = t0.elapsed().as_secs_f64();
+    Ok(Replayed {
+        columns,
+        las,
+        trajectory,
+        dropped,
+        kernel,
+        times,
+    })
+}
+
+/// Extracts road edges from a LAS/LAZ file and its trajectory with the bend method and all
+/// points of the file (one scanner).
+pub fn extract_file(
+    points: &Path,
+    traj: &Path,
+    cfg: &Config,
+) -> Result<ExtractResult, ExtractError> {
+    extract_file_with(
+        points,
+        traj,
+        cfg,
+        &ExtractOptions::default(),
+        &Progress::hidden(),
+    )
+}
+
+/// [`extract_file`] with a scanner, a method and a progress display.
+pub fn extract_file_with(
+    points: &Path,
+    traj: &Path,
+    cfg: &Config,
+    opts: &ExtractOptions,
+    progress: &Progress,
+) -> Result<ExtractResult, ExtractError> {
+    let start = Instant::now();
+    if opts.method != Method::Bend {
+        return Err(ExtractError::Method(opts.method.as_str().into()));
+    }
+    let mut r = replay_file(points, traj, cfg, opts, progress)?;
+    // The scan angle and intensity columns served the replay; free them before the
+    // methods' own indexes are built (6 B per point).
+    r.columns.scan_angle_deg = Vec::new();
+    r.columns.intensity = Vec::new();
+    let t0 = Instant::now();
+    progress.stage("edges", 0);
+    let input = BendInput {
+        x: &r.columns.x,
+        y: &r.columns.y,
+        z: &r.columns.z,
+        t: &r.columns.t,
+        rho_deg: &r.kernel.rho_deg,
+        status: &r.kernel.status,
+        scanline: &r.kernel.scanline,
+        candidates: &r.kernel.candidates,
+        trajectory: &r.trajectory,
+    };
+    let mut edges = bend::extract_edges(&input, &cfg.bend);
+    for e in &mut edges {
+        e.method
+            .get_or_insert_with(|| Method::Bend.as_str().to_string());
+    }
+    r.times.edges_s = t0.elapsed().as_secs_f64();
+    progress.finish();
+    r.times.total_s = start.elapsed().as_secs_f64();
+    let summary = Summary {
+        dropped_before_trajectory: r.dropped.0,
+        dropped_after_trajectory: r.dropped.1,
+        core: r.kernel.counters,
+        candidates: r.kernel.candidates.len() as u64,
+        edges: edges.len() as u64,
+        total_length_m: edges.iter().map(|e| e.length_m()).sum(),
+        times: r.times,
+        las: r.las.clone(),
+    };
+    Ok(ExtractResult {
+        crs: r.las.crs.clone(),
+        edges,
+        summary,
+    })
+}
+
+/// Writes edges as CSV vertex lists: `edge,side,vertex,x,y,z` (one row per vertex).
+pub fn write_edges_csv(path: &Path, edges: &[EdgeLine]) -> std::io::Result<()> {
+    use std::io::Write;
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(w, "edge,side,vertex,x,y,z")?;
+    for (k, e) in edges.iter().enumerate() {
+        for (v, p) in e.points.iter().enumerate() {
+            writeln!(
+                w,
+                "{k},{},{v},{:.4},{:.4},{:.4}",
+                e.side.as_str(),
+                p[0],
+                p[1],
+                p[2]
+            )?;
+        }
+    }
+    w.flush()
+}

@@ -1,0 +1,516 @@
+//! The plane-based road-edge method of Qiu et al. (2016), "A fast and robust algorithm for
+//! road edges extraction from LiDAR data" (`papers/002_ce63f0f98c12cff3.txt`), on
+//! unorganised points, all on the host.
+//!
+//! | paper | module |
+//! |---|---|
+//! | §3.1 partition by GPS time and trajectory | [`partition`] |
+//! | §3.2 outlier removal, down-sampling | [`preprocess`] |
+//! | §3.3.1 grid minimum-z normalisation | [`normalise`] |
+//! | §3.3.2 rough plane α, refined planes β_i, candidates, E_s | [`segment`] |
+//! | §3.4 refinement by road width and by continuity | [`refine`] |
+//! | §4.2 parameters | [`params`] |
+//!
+//! Sections are processed in parallel (rayon); each section's RANSAC draws come from a
+//! seed mixed with the section index and results are collected in section order, so the
+//! output does not depend on the number of threads. Each section keeps only its *core*
+//! stations (see [`partition`]) and the pieces are joined across section boundaries, so
+//! an edge seen by two overlapping sections is output once.
+
+pub mod normalise;
+pub mod params;
+pub mod partition;
+pub mod preprocess;
+pub mod refine;
+pub mod segment;
+
+pub use params::{QiuParams, QiuParamsError};
+
+use crate::io::trajectory::Trajectory;
+use crate::model::{Category, EdgeLine, Side};
+use partition::{plan_sections, stations, Section, SectionTrack};
+use rayon::prelude::*;
+use refine::{Chain, EdgePoint};
+use std::collections::HashMap;
+
+/// What the method reads: world point columns (all the same length) and the trajectory.
+#[derive(Clone, Copy)]
+pub struct QiuInput<'a> {
+    /// World X, metres.
+    pub x: &'a [f64],
+    /// World Y, metres.
+    pub y: &'a [f64],
+    /// World Z, metres.
+    pub z: &'a [f64],
+    /// GPS time, seconds (any order).
+    pub t: &'a [f64],
+    /// The trajectory, in the same CRS and time base.
+    pub trajectory: &'a Trajectory,
+}
+
+/// What happened in one section (for reports and tests).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SectionReport {
+    /// The section.
+    pub section: Option<Section>,
+    /// Points inside the section's time interval and width.
+    pub points_in: usize,
+    /// Points after outlier removal and down-sampling.
+    pub points_preprocessed: usize,
+    /// The β whose candidate set had the smallest E_s.
+    pub beta_m: Option<f64>,
+    /// (β, candidates, E_s) per refined plane.
+    pub energies: Vec<(f64, usize, Option<f64>)>,
+    /// Candidate edge points of the chosen set.
+    pub candidates: usize,
+    /// The most frequent road width of the section (Eq. 3).
+    pub road_width_m: Option<f64>,
+    /// Points kept by the road-width refinement.
+    pub width_kept: usize,
+    /// Chains kept by the continuity refinement (before clipping to the core).
+    pub chains: usize,
+}
+
+/// What happened overall.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct QiuReport {
+    /// Points given.
+    pub points_total: usize,
+    /// Points dropped for a non-finite coordinate or time.
+    pub points_not_finite: usize,
+    /// Per section, in order.
+    pub sections: Vec<SectionReport>,
+}
+
+/// Extracts road edges with the method of Qiu et al. (2016). Lines carry `method` = "qiu",
+/// their side of the trajectory, the median height step across them and, from it, a
+/// category (`curb` at 50 mm or more, `curb_cut` from 10 mm).
+pub fn extract_edges(points: &QiuInput, params: &QiuParams) -> Vec<EdgeLine> {
+    extract_edges_with_report(points, params).0
+}
+
+/// [`extract_edges`] with a report of every section. Invalid parameters give no lines
+/// (check them first with [`QiuParams::validate`]).
+pub fn extract_edges_with_report(
+    input: &QiuInput,
+    params: &QiuParams,
+) -> (Vec<EdgeLine>, QiuReport) {
+    let n = input
+        .x
+        .len()
+        .min(input.y.len())
+        .min(input.z.len())
+        .min(input.t.len());
+    let mut report = QiuReport {
+        points_total: n,
+        ..Default::default()
+    };
+    if params.validate().is_err() {
+        return (Vec::new(), report);
+    }
+    // Points ordered by GPS time, so a section's points are one slice (§3.1).
+    let mut order: Vec<usize> = (0..n)
+        .filter(|&i| {
+            input.x[i].is_finite()
+                && input.y[i].is_finite()
+                && input.z[i].is_finite()
+                && input.t[i].is_finite()
+        })
+        .collect();
+    report.points_not_finite = n - order.len();
+    if !order.windows(2).all(|w| input.t[w[0]] <= input.t[w[1]]) {
+        order.par_sort_by(|&a, &b| input.t[a].total_cmp(&input.t[b]).then(a.cmp(&b)));
+    }
+    let times: Vec<f64> = order.iter().map(|&i| input.t[i]).collect();
+    let st = stations(input.trajectory);
+    let sections = plan_sections(input.trajectory, params);
+    let results: Vec<(Vec<Chain>, SectionReport)> = sections
+        .par_iter()
+        .map(|sec| process_section(input, &order, &times, &st, sec, params))
+        .collect();
+    let mut pieces = Vec::new();
+    for (chains, rep) in results {
+        pieces.extend(chains);
+        report.sections.push(rep);
+    }
+    let chains = refine::keep_longest(refine::join_chains(pieces, params), params);
+    let lines = chains
+        .into_iter()
+        .map(|c| {
+            let mut hs: Vec<f64> = c.h.iter().copied().filter(|h| h.is_finite()).collect();
+            hs.sort_unstable_by(f64::total_cmp);
+            let curb_height_m = (!hs.is_empty()).then(|| hs[hs.len() / 2]);
+            let category = curb_height_m.and_then(|h| {
+                if h >= 0.05 {
+                    Some(Category::Curb)
+                } else if h >= 0.01 {
+                    Some(Category::CurbCut)
+                } else {
+                    None
+                }
+            });
+            EdgeLine {
+                points: c.pts,
+                side: c.side,
+                category,
+                method: Some("qiu".into()),
+                curb_height_m,
+            }
+        })
+        .collect();
+    (lines, report)
+}
+
+/// Seconds of trajectory added before and after a section for nearest-trajectory-point
+/// queries, so points seen ahead of or behind the vehicle still find their foot point.
+const TRACK_PAD_S: f64 = 5.0;
+
+fn process_section(
+    input: &QiuInput,
+    order: &[usize],
+    times: &[f64],
+    st: &[f64],
+    sec: &Section,
+    params: &QiuParams,
+) -> (Vec<Chain>, SectionReport) {
+    let mut rep = SectionReport {
+        section: Some(*sec),
+        ..Default::default()
+    };
+    let traj = input.trajectory;
+    let Some(origin) = traj.pose_at(sec.t_start) else {
+        return (Vec::new(), rep);
+    };
+    let o = [origin.x, origin.y, origin.z];
+    // §3.1: the section's GPS time interval, then its width across the trajectory.
+    let lo = times.partition_point(|&t| t < sec.t_start);
+    let hi = times.partition_point(|&t| t <= sec.t_end);
+    let half_w = 0.5 * params.section_width_m;
+    let raw: Vec<[f64; 3]> = order[lo..hi]
+        .par_iter()
+        .filter_map(|&i| {
+            let q = traj.pose_at(input.t[i])?;
+            let l = q.left();
+            let d = (input.x[i] - q.x) * l[0] + (input.y[i] - q.y) * l[1];
+            (d.abs() <= half_w).then(|| [input.x[i] - o[0], input.y[i] - o[1], input.z[i] - o[2]])
+        })
+        .collect();
+    rep.points_in = raw.len();
+    // §3.2.
+    let pts = if params.sor_after_voxel {
+        let v = preprocess::voxel_downsample(&raw, params.voxel_m);
+        preprocess::statistical_outlier_removal(&v, params.sor_k, params.sor_std_mul)
+    } else {
+        let s = preprocess::statistical_outlier_removal(&raw, params.sor_k, params.sor_std_mul);
+        preprocess::voxel_downsample(&s, params.voxel_m)
+    };
+    drop(raw);
+    rep.points_preprocessed = pts.len();
+    // §3.3.1.
+    let norm = normalise::normalise_to_grid_min(&pts, params.grid_cell_m);
+    let pts_norm: Vec<[f64; 3]> = pts
+        .iter()
+        .zip(&norm.z_norm)
+        .map(|(p, &z)| [p[0], p[1], z])
+        .collect();
+    // §3.3.2.
+    let track = SectionTrack::new(traj, st, sec.t_start - TRACK_PAD_S, sec.t_end + TRACK_PAD_S);
+    let locate = |i: usize| track.locate(pts[i][0] + o[0], pts[i][1] + o[1]);
+    let seg = segment::rough_segmentation(
+        &pts_norm,
+        params.alpha_m,
+        &params.betas_m,
+        params.ransac_iterations,
+        params.ransac_max_tilt_deg,
+        params.neighbour_radius_m,
+        params.min_candidates,
+        params.energy_tolerance,
+        params.seed ^ (sec.index as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15),
+        &|i| locate(i).map(|p| (p.s, p.d)),
+    );
+    rep.beta_m = seg.beta_m;
+    rep.energies = seg.energies.clone();
+    rep.candidates = seg.candidates.len();
+    let edge_pts: Vec<EdgePoint> = seg
+        .candidates
+        .iter()
+        .filter_map(|&i| {
+            let tp = locate(i)?;
+            Some(EdgePoint {
+                p: [pts[i][0] + o[0], pts[i][1] + o[1], norm.ground_z[i] + o[2]],
+                s: tp.s,
+                d: tp.d,
+                foot: tp.foot,
+            })
+        })
+        .collect();
+    // §3.4.
+    let width = refine::refine_by_width(&edge_pts, params);
+    rep.road_width_m = width.road_width_m;
+    rep.width_kept = width.kept.len();
+    let mut chains = refine::refine_by_continuity(&edge_pts, &width.kept, params);
+    rep.chains = chains.len();
+    let grid = HeightGrid::new(&pts, o);
+    for c in &mut chains {
+        grid.measure_steps(c, params.height_band_m);
+    }
+    let clipped: Vec<Chain> = chains
+        .iter()
+        .flat_map(|c| refine::clip_to_stations(c, sec.core_start, sec.core_end))
+        .collect();
+    (clipped, rep)
+}
+
+/// The section's pre-processed points on a 2D grid, for the height step across a line.
+struct HeightGrid<'a> {
+    pts: &'a [[f64; 3]],
+    origin: [f64; 3],
+    cells: HashMap<(i64, i64), Vec<u32>>,
+}
+
+const HEIGHT_CELL_M: f64 = 0.5;
+
+impl<'a> HeightGrid<'a> {
+    fn new(pts: &'a [[f64; 3]], origin: [f64; 3]) -> Self {
+        let mut cells: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
+        for (i, p) in pts.iter().enumerate() {
+            let k = (
+                (p[0] / HEIGHT_CELL_M).floor() as i64,
+                (p[1] / HEIGHT_CELL_M).floor() as i64,
+            );
+            cells.entry(k).or_default().push(i as u32);
+        }
+        Self { pts, origin, cells }
+    }
+
+    /// For every vertex: the median z of points `band` metres outward (away from the
+    /// trajectory) minus the median z of points as far inward, within half a metre along
+    /// the line. The vertex z becomes the inward (road) median: the toe's height.
+    fn measure_steps(&self, c: &mut Chain, band: [f64; 2]) {
+        let n = c.pts.len();
+        for k in 0..n {
+            let (a, b) = (c.pts[k.saturating_sub(1)], c.pts[(k + 1).min(n - 1)]);
+            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+            let len = dx.hypot(dy);
+            if len < 1e-9 {
+                continue;
+            }
+            let u = [dx / len, dy / len];
+            // Left of the driving direction is (−u_y, u_x); outward is left on the left.
+            let sgn = if c.side == Side::Left { 1.0 } else { -1.0 };
+            let nout = [-u[1] * sgn, u[0] * sgn];
+            let q = [c.pts[k][0] - self.origin[0], c.pts[k][1] - self.origin[1]];
+            let r = band[1] + 0.5;
+            let (kx0, kx1) = (
+                ((q[0] - r) / HEIGHT_CELL_M).floor() as i64,
+                ((q[0] + r) / HEIGHT_CELL_M).floor() as i64,
+            );
+            let (ky0, ky1) = (
+                ((q[1] - r) / HEIGHT_CELL_M).floor() as i64,
+                ((q[1] + r) / HEIGHT_CELL_M).floor() as i64,
+            );
+            let (mut outer, mut inner) = (Vec::new(), Vec::new());
+            for kx in kx0..=kx1 {
+                for ky in ky0..=ky1 {
+                    for &i in self.cells.get(&(kx, ky)).map(Vec::as_slice).unwrap_or(&[]) {
+                        let p = self.pts[i as usize];
+                        let (px, py) = (p[0] - q[0], p[1] - q[1]);
+                        if (px * u[0] + py * u[1]).abs() > 0.5 {
+                            continue;
+                        }
+                        let across = px * nout[0] + py * nout[1];
+                        if (band[0]..=band[1]).contains(&across) {
+                            outer.push(p[2]);
+                        } else if (band[0]..=band[1]).contains(&-across) {
+                            inner.push(p[2]);
+                        }
+                    }
+                }
+            }
+            if inner.len() >= 3 {
+                inner.sort_unstable_by(f64::total_cmp);
+                let zi = inner[inner.len() / 2];
+                c.pts[k][2] = zi + self.origin[2];
+                if outer.len() >= 3 {
+                    outer.sort_unstable_by(f64::total_cmp);
+                    c.h[k] = outer[outer.len() / 2] - zi;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::trajectory::Pose;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    const X0: f64 = 500_000.0;
+    const Y0: f64 = 4_000_000.0;
+    const T0: f64 = 4.0e8;
+
+    /// A straight road along +x (driving east, left = +y), 10 m wide between curb toes at
+    /// y = ±5, 150 mm curbs with vertical faces, 3 m sidewalks, and 1 m walls at their
+    /// back (y = ±8), over x ∈ [0, `len`]; points on a 5 cm jittered grid with 3 mm height
+    /// noise, a few isolated outliers; time = when the vehicle (10 m/s) passed x. The
+    /// vehicle drives down the middle, 0.2 m left of it (so the toes do not fall exactly
+    /// on the boundaries of the 0.5 m normalisation grid, which starts at the vehicle).
+    fn synthetic_road(len: f64, seed: u64) -> (Vec<[f64; 4]>, Trajectory) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut pts = Vec::new();
+        let step = 0.05;
+        let nx = (len / step) as i64;
+        let mut push = |rng: &mut ChaCha8Rng, x: f64, y: f64, z: f64| {
+            let z = z + rng.gen_range(-0.003..0.003);
+            pts.push([X0 + x, Y0 + y, 10.0 + z, T0 + x / 10.0]);
+        };
+        for ix in 0..=nx {
+            for iy in -160..=160 {
+                let x = ix as f64 * step + rng.gen_range(-0.01..0.01);
+                let y = iy as f64 * step + rng.gen_range(-0.01..0.01);
+                let z = if y.abs() < 5.0 { 0.0 } else { 0.15 };
+                push(&mut rng, x, y, z);
+            }
+            let x = ix as f64 * step;
+            for side in [-1.0, 1.0] {
+                for k in 1..8 {
+                    push(&mut rng, x, side * 5.0, k as f64 * 0.02);
+                }
+                for k in 1..20 {
+                    push(&mut rng, x, side * 8.0, 0.15 + k as f64 * 0.05);
+                }
+            }
+        }
+        for k in 0..20 {
+            push(&mut rng, k as f64 * 2.5, 0.0, 3.0);
+        }
+        let samples = (0..=((len + 10.0) * 10.0) as usize)
+            .map(|k| {
+                let x = -5.0 + k as f64 * 0.1;
+                Pose {
+                    t: T0 + x / 10.0,
+                    x: X0 + x,
+                    y: Y0 + 0.2,
+                    z: 12.0,
+                    roll_deg: 0.0,
+                    pitch_deg: 0.0,
+                    heading_deg: 90.0,
+                }
+            })
+            .collect();
+        (pts, Trajectory { samples })
+    }
+
+    fn seg_dist(p: [f64; 2], a: [f64; 3], b: [f64; 3]) -> f64 {
+        let (ux, uy) = (b[0] - a[0], b[1] - a[1]);
+        let l2 = ux * ux + uy * uy;
+        let w = if l2 > 0.0 {
+            (((p[0] - a[0]) * ux + (p[1] - a[1]) * uy) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (p[0] - a[0] - w * ux).hypot(p[1] - a[1] - w * uy)
+    }
+
+    fn near_any(p: [f64; 2], lines: &[EdgeLine], buf: f64) -> bool {
+        lines.iter().any(|l| {
+            l.points.windows(2).any(|w| seg_dist(p, w[0], w[1]) <= buf)
+                || (l.points.len() == 1 && seg_dist(p, l.points[0], l.points[0]) <= buf)
+        })
+    }
+
+    #[test]
+    fn finds_both_curbs_of_a_synthetic_road() {
+        let len = 50.0;
+        let (pts, traj) = synthetic_road(len, 11);
+        let col = |k: usize| pts.iter().map(|p| p[k]).collect::<Vec<f64>>();
+        let (x, y, z, t) = (col(0), col(1), col(2), col(3));
+        let input = QiuInput {
+            x: &x,
+            y: &y,
+            z: &z,
+            t: &t,
+            trajectory: &traj,
+        };
+        // 30 m sections with 10 m overlap over the 60 m drive: [0,30], [20,50], [40,60].
+        let params = QiuParams {
+            section_length_m: 30.0,
+            section_overlap_m: 10.0,
+            ..QiuParams::default()
+        };
+        let (lines, rep) = extract_edges_with_report(&input, &params);
+        assert_eq!(rep.sections.len(), 3);
+        for s in &rep.sections {
+            // The curb face is 150 mm: any β up to 0.08 m leaves part of it outside.
+            assert!(s.beta_m.is_some(), "{s:?}");
+            // Curb to curb: 10 m (bin [10.0, 10.1)).
+            assert!((s.road_width_m.unwrap() - 10.05).abs() < 0.11, "{s:?}");
+        }
+        // Score: reference samples every 0.1 m on y = ±5 within 0.2 m of an output line.
+        for side in [Side::Left, Side::Right] {
+            let y_ref = if side == Side::Left {
+                Y0 + 5.0
+            } else {
+                Y0 - 5.0
+            };
+            let mine: Vec<EdgeLine> = lines.iter().filter(|l| l.side == side).cloned().collect();
+            let n = (len * 10.0) as usize;
+            let hit = (0..=n)
+                .filter(|&k| near_any([X0 + k as f64 * 0.1, y_ref], &mine, 0.2))
+                .count();
+            let completeness = hit as f64 / (n + 1) as f64;
+            assert!(
+                completeness >= 0.85,
+                "{side:?}: completeness {completeness}"
+            );
+            // Correctness: output vertices within 0.2 m of the reference line.
+            let verts: Vec<&[f64; 3]> = mine.iter().flat_map(|l| l.points.iter()).collect();
+            let ok = verts.iter().filter(|p| (p[1] - y_ref).abs() <= 0.2).count();
+            assert!(
+                ok as f64 >= 0.9 * verts.len() as f64,
+                "{side:?}: {ok}/{}",
+                verts.len()
+            );
+        }
+        for l in &lines {
+            assert_eq!(l.method.as_deref(), Some("qiu"));
+            let h = l.curb_height_m.unwrap();
+            assert!((h - 0.15).abs() < 0.03, "height {h}");
+            assert_eq!(l.category, Some(Category::Curb));
+            // z is the road surface at the toe (10 m ± noise).
+            assert!(
+                l.points.iter().all(|p| (p[2] - 10.0).abs() < 0.02),
+                "{:?}",
+                l.points
+            );
+        }
+        // The same result with one thread and with many.
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let again = one.install(|| extract_edges(&input, &params));
+        assert_eq!(again, lines);
+    }
+
+    #[test]
+    fn no_points_or_no_trajectory_gives_no_lines() {
+        let traj = Trajectory::default();
+        let input = QiuInput {
+            x: &[],
+            y: &[],
+            z: &[],
+            t: &[],
+            trajectory: &traj,
+        };
+        assert!(extract_edges(&input, &QiuParams::default()).is_empty());
+        let (_, traj) = synthetic_road(5.0, 1);
+        let input = QiuInput {
+            trajectory: &traj,
+            ..input
+        };
+        assert!(extract_edges(&input, &QiuParams::default()).is_empty());
+    }
+}

@@ -1,0 +1,637 @@
+//! §3.4 Refined road edge extracting: by the stable road width (Eq. 3) and by road
+//! continuity (Eq. 4): Euclidean clusters, line segments fitted in each, segments joined by
+//! direction and position, the longest chains kept.
+
+use super::params::QiuParams;
+use crate::model::Side;
+use std::collections::HashMap;
+
+/// A candidate road-edge point with its place relative to the trajectory.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgePoint {
+    /// World x, y and the terrain height under the point (grid minimum), metres.
+    pub p: [f64; 3],
+    /// Station of the nearest trajectory point, metres.
+    pub s: f64,
+    /// Signed offset from the nearest trajectory point along its left vector, metres.
+    pub d: f64,
+    /// The nearest trajectory point P_i (x, y).
+    pub foot: [f64; 2],
+}
+
+impl EdgePoint {
+    /// Left when the offset is positive.
+    pub fn side(&self) -> Side {
+        if self.d > 0.0 {
+            Side::Left
+        } else {
+            Side::Right
+        }
+    }
+}
+
+/// The result of the road-width refinement.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WidthRefinement {
+    /// Indices of the kept points.
+    pub kept: Vec<usize>,
+    /// The most frequent temporary road width over all pairs, metres (for reports).
+    pub road_width_m: Option<f64>,
+    /// Number of left–right pairs found.
+    pub pairs: usize,
+}
+
+/// The most frequent value of `vals` on bins of `bin` (ties: the smaller value), as the
+/// bin centre.
+fn mode(vals: impl Iterator<Item = f64>, bin: f64) -> Option<f64> {
+    let mut h: HashMap<i64, usize> = HashMap::new();
+    for v in vals {
+        *h.entry((v / bin).floor() as i64).or_default() += 1;
+    }
+    h.into_iter()
+        .max_by(|a, b| a.1.cmp(&b.1).then(b.0.cmp(&a.0)))
+        .map(|(k, _)| (k as f64 + 0.5) * bin)
+}
+
+fn median(v: &mut [f64]) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_unstable_by(f64::total_cmp);
+    let n = v.len();
+    Some(if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    })
+}
+
+/// §3.4.1, Eq. 3. For every left candidate L_i with nearest trajectory point P_i, R_i is the
+/// right candidate within `width_pair_m` of the line L_i P_i nearest to P_i; |L_i R_i| is a
+/// temporary road width. The most frequent width (within `width_window_m` along the
+/// trajectory, so a width change inside a section is followed) is the road width, and the
+/// pairs within `width_tolerance_m` of it are road-edge points.
+///
+/// Where the other side's edge is hidden (a parked car) a correct point has no matching
+/// pair; the paper then loses it (its Urban 3). We keep such a point when its offset agrees
+/// within `width_tolerance_m` with the median offset of the matched points of its side
+/// within `offset_window_m`, and points of a side with no matched point nearby are kept for
+/// the continuity step to judge.
+pub fn refine_by_width(pts: &[EdgePoint], params: &QiuParams) -> WidthRefinement {
+    let mut right: Vec<usize> = (0..pts.len()).filter(|&i| pts[i].d < 0.0).collect();
+    right.sort_by(|&a, &b| pts[a].s.total_cmp(&pts[b].s).then(a.cmp(&b)));
+    let right_s: Vec<f64> = right.iter().map(|&i| pts[i].s).collect();
+    // (station, width, left index, right index)
+    let mut pairs: Vec<(f64, f64, usize, usize)> = Vec::new();
+    for (li, l) in pts.iter().enumerate().filter(|(_, p)| p.d > 0.0) {
+        let dir = [l.foot[0] - l.p[0], l.foot[1] - l.p[1]];
+        let len = dir[0].hypot(dir[1]);
+        if len < 1e-9 {
+            continue;
+        }
+        let dir = [dir[0] / len, dir[1] / len];
+        // On a straight road the distance to the line L_i P_i is the station difference;
+        // a wider pre-filter allows for curvature.
+        let reach = 4.0 * params.width_pair_m;
+        let lo = right_s.partition_point(|&s| s < l.s - reach);
+        let hi = right_s.partition_point(|&s| s <= l.s + reach);
+        let best = right[lo..hi]
+            .iter()
+            .copied()
+            .filter(|&ri| {
+                let r = &pts[ri];
+                let v = [r.p[0] - l.p[0], r.p[1] - l.p[1]];
+                (v[0] * dir[1] - v[1] * dir[0]).abs() <= params.width_pair_m
+            })
+            .min_by(|&a, &b| pts[a].d.abs().total_cmp(&pts[b].d.abs()).then(a.cmp(&b)));
+        if let Some(ri) = best {
+            let r = &pts[ri];
+            pairs.push((l.s, (r.p[0] - l.p[0]).hypot(r.p[1] - l.p[1]), li, ri));
+        }
+    }
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+    let road_width_m = mode(pairs.iter().map(|p| p.1), params.width_bin_m);
+    // Matched points per side: (station, |offset|).
+    let mut matched: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
+    let half = 0.5 * params.width_window_m;
+    let mut is_matched = vec![false; pts.len()];
+    for (k, &(s, w, li, ri)) in pairs.iter().enumerate() {
+        let lo = pairs[..k].partition_point(|p| p.0 < s - half);
+        let hi = k + pairs[k..].partition_point(|p| p.0 <= s + half);
+        let Some(wm) = mode(pairs[lo..hi].iter().map(|p| p.1), params.width_bin_m) else {
+            continue;
+        };
+        if (w - wm).abs() <= params.width_tolerance_m {
+            is_matched[li] = true;
+            is_matched[ri] = true;
+        }
+    }
+    for (p, _) in pts.iter().zip(&is_matched).filter(|(_, &m)| m) {
+        matched[usize::from(p.d < 0.0)].push((p.s, p.d.abs()));
+    }
+    for m in &mut matched {
+        m.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    }
+    let ohalf = 0.5 * params.offset_window_m;
+    let mut kept = Vec::new();
+    for (i, p) in pts.iter().enumerate() {
+        if is_matched[i] {
+            kept.push(i);
+            continue;
+        }
+        let m = &matched[usize::from(p.d < 0.0)];
+        let lo = m.partition_point(|q| q.0 < p.s - ohalf);
+        let hi = m.partition_point(|q| q.0 <= p.s + ohalf);
+        let mut offs: Vec<f64> = m[lo..hi].iter().map(|q| q.1).collect();
+        match median(&mut offs) {
+            None => kept.push(i),
+            Some(e) if (p.d.abs() - e).abs() <= params.width_tolerance_m => kept.push(i),
+            Some(_) => {}
+        }
+    }
+    WidthRefinement {
+        kept,
+        road_width_m,
+        pairs: pairs.len(),
+    }
+}
+
+/// Euclidean cluster extraction (2D): points closer than `tol` (directly or through
+/// others) share a cluster. Clusters are returned with their members in index order,
+/// ordered by their smallest member.
+pub fn euclidean_clusters(xy: &[[f64; 2]], tol: f64) -> Vec<Vec<usize>> {
+    let key = |p: &[f64; 2]| ((p[0] / tol).floor() as i64, (p[1] / tol).floor() as i64);
+    let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    for (i, p) in xy.iter().enumerate() {
+        grid.entry(key(p)).or_default().push(i);
+    }
+    let mut parent: Vec<usize> = (0..xy.len()).collect();
+    fn find(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let t2 = tol * tol;
+    for (i, p) in xy.iter().enumerate() {
+        let k = key(p);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                let Some(cell) = grid.get(&(k.0 + dx, k.1 + dy)) else {
+                    continue;
+                };
+                for &j in cell {
+                    if j > i && (xy[j][0] - p[0]).powi(2) + (xy[j][1] - p[1]).powi(2) <= t2 {
+                        let (a, b) = (find(&mut parent, i), find(&mut parent, j));
+                        if a != b {
+                            parent[a.max(b)] = a.min(b);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let mut by_root: HashMap<usize, Vec<usize>> = HashMap::new();
+    for i in 0..xy.len() {
+        let r = find(&mut parent, i);
+        by_root.entry(r).or_default().push(i);
+    }
+    let mut out: Vec<Vec<usize>> = by_root.into_values().collect();
+    out.sort_by_key(|c| c[0]);
+    out
+}
+
+/// Douglas–Peucker: the indices of the vertices kept at tolerance `tol`.
+pub fn douglas_peucker(pts: &[[f64; 3]], tol: f64) -> Vec<usize> {
+    if pts.len() <= 2 {
+        return (0..pts.len()).collect();
+    }
+    let mut keep = vec![false; pts.len()];
+    keep[0] = true;
+    keep[pts.len() - 1] = true;
+    let mut stack = vec![(0, pts.len() - 1)];
+    while let Some((a, b)) = stack.pop() {
+        if b <= a + 1 {
+            continue;
+        }
+        let (pa, pb) = (pts[a], pts[b]);
+        let (ux, uy) = (pb[0] - pa[0], pb[1] - pa[1]);
+        let len = ux.hypot(uy);
+        let mut far = (a, 0.0);
+        for (k, p) in pts.iter().enumerate().take(b).skip(a + 1) {
+            let dist = if len < 1e-12 {
+                (p[0] - pa[0]).hypot(p[1] - pa[1])
+            } else {
+                ((p[0] - pa[0]) * uy - (p[1] - pa[1]) * ux).abs() / len
+            };
+            if dist > far.1 {
+                far = (k, dist);
+            }
+        }
+        if far.1 > tol {
+            keep[far.0] = true;
+            stack.push((a, far.0));
+            stack.push((far.0, b));
+        }
+    }
+    (0..pts.len()).filter(|&i| keep[i]).collect()
+}
+
+/// A road-edge polyline with the station of every vertex.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chain {
+    /// Side of the trajectory.
+    pub side: Side,
+    /// Vertices: world x, y and terrain z.
+    pub pts: Vec<[f64; 3]>,
+    /// Station of every vertex.
+    pub s: Vec<f64>,
+    /// Height step across the line at every vertex, metres (NaN where unknown).
+    pub h: Vec<f64>,
+}
+
+impl Chain {
+    /// Horizontal length.
+    pub fn length_m(&self) -> f64 {
+        self.pts
+            .windows(2)
+            .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+            .sum()
+    }
+
+    fn s_range(&self) -> (f64, f64) {
+        self.s
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &s| {
+                (a.min(s), b.max(s))
+            })
+    }
+
+    /// Unit direction of the last (`at_end`) or first segment.
+    fn direction(&self, at_end: bool) -> Option<[f64; 2]> {
+        let n = self.pts.len();
+        if n < 2 {
+            return None;
+        }
+        let (a, b) = if at_end {
+            (self.pts[n - 2], self.pts[n - 1])
+        } else {
+            (self.pts[0], self.pts[1])
+        };
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len = dx.hypot(dy);
+        (len > 1e-9).then(|| [dx / len, dy / len])
+    }
+}
+
+/// The line segments of one cluster (§3.4.2 step 2): the cluster's points are ordered along
+/// its main direction (PCA), summarised every `bin_m` by the median x, y, z and station,
+/// and simplified into line segments by Douglas–Peucker. Oriented along increasing station.
+pub fn fit_segments(pts: &[EdgePoint], members: &[usize], params: &QiuParams) -> Option<Chain> {
+    let n = members.len() as f64;
+    let (mx, my) = members.iter().fold((0.0, 0.0), |(a, b), &i| {
+        (a + pts[i].p[0] / n, b + pts[i].p[1] / n)
+    });
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for &i in members {
+        let (dx, dy) = (pts[i].p[0] - mx, pts[i].p[1] - my);
+        sxx += dx * dx;
+        sxy += dx * dy;
+        syy += dy * dy;
+    }
+    // Main axis of the 2×2 covariance.
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let u = [theta.cos(), theta.sin()];
+    let mut bins: std::collections::BTreeMap<i64, Vec<usize>> = Default::default();
+    for &i in members {
+        let t = (pts[i].p[0] - mx) * u[0] + (pts[i].p[1] - my) * u[1];
+        bins.entry((t / params.bin_m).floor() as i64)
+            .or_default()
+            .push(i);
+    }
+    let mut verts = Vec::with_capacity(bins.len());
+    let mut stations = Vec::with_capacity(bins.len());
+    for b in bins.values() {
+        let col = |f: &dyn Fn(&EdgePoint) -> f64| {
+            let mut v: Vec<f64> = b.iter().map(|&i| f(&pts[i])).collect();
+            median(&mut v).unwrap_or(f64::NAN)
+        };
+        verts.push([col(&|p| p.p[0]), col(&|p| p.p[1]), col(&|p| p.p[2])]);
+        stations.push(col(&|p| p.s));
+    }
+    let keep = douglas_peucker(&verts, params.segment_tolerance_m);
+    let mut chain = Chain {
+        side: pts[members[0]].side(),
+        pts: keep.iter().map(|&k| verts[k]).collect(),
+        s: keep.iter().map(|&k| stations[k]).collect(),
+        h: vec![f64::NAN; keep.len()],
+    };
+    if chain.s.last()? < chain.s.first()? {
+        chain.pts.reverse();
+        chain.s.reverse();
+    }
+    Some(chain)
+}
+
+/// Whether chain `b` continues chain `a` (§3.4.2 step 3, Eq. 4's K < γ): the gap from `a`'s
+/// end to `b`'s start is at most `join_gap_m`, `b` starts beyond `a`'s end along the
+/// trajectory, the directions differ by at most γ and `b`'s start lies within
+/// `join_lateral_m` of the line of `a`'s last segment. Returns the gap.
+fn continues(a: &Chain, b: &Chain, params: &QiuParams) -> Option<f64> {
+    let (ea, sb) = (a.pts.last()?, b.pts.first()?);
+    let gap = (sb[0] - ea[0]).hypot(sb[1] - ea[1]);
+    if gap > params.join_gap_m || b.s[0] < a.s[a.s.len() - 1] - params.join_lateral_m {
+        return None;
+    }
+    if let Some(da) = a.direction(true) {
+        let lateral = ((sb[0] - ea[0]) * da[1] - (sb[1] - ea[1]) * da[0]).abs();
+        if lateral > params.join_lateral_m {
+            return None;
+        }
+        if let Some(db) = b.direction(false) {
+            let cos = (da[0] * db[0] + da[1] * db[1]).clamp(-1.0, 1.0);
+            if cos.acos().to_degrees() > params.join_angle_deg {
+                return None;
+            }
+        }
+    }
+    Some(gap)
+}
+
+/// Joins chains of one side end to start (§3.4.2 step 3), greedily in order of their first
+/// station: each chain is appended to the already built chain it continues with the
+/// smallest gap, else starts a new one.
+pub fn join_chains(mut pieces: Vec<Chain>, params: &QiuParams) -> Vec<Chain> {
+    pieces.sort_by(|a, b| {
+        a.s[0]
+            .total_cmp(&b.s[0])
+            .then(a.pts[0][0].total_cmp(&b.pts[0][0]))
+    });
+    let mut out: Vec<Chain> = Vec::new();
+    for p in pieces {
+        let best = out
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| c.side == p.side)
+            .filter_map(|(k, c)| continues(c, &p, params).map(|g| (k, g)))
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+        match best {
+            Some((k, _)) => {
+                let c = &mut out[k];
+                // Drop a duplicated vertex where two clipped pieces meet (the two
+                // sections' lines agree to a few millimetres there).
+                let skip = usize::from(
+                    p.pts.len() > 1
+                        && (c.pts[c.pts.len() - 1][0] - p.pts[0][0])
+                            .hypot(c.pts[c.pts.len() - 1][1] - p.pts[0][1])
+                            < 0.05,
+                );
+                c.pts.extend_from_slice(&p.pts[skip..]);
+                c.s.extend_from_slice(&p.s[skip..]);
+                c.h.extend_from_slice(&p.h[skip..]);
+            }
+            None => out.push(p),
+        }
+    }
+    out
+}
+
+/// §3.4.2 step 4: chains shorter than `min_chain_m` are dropped; of chains on the same
+/// side overlapping along the trajectory by more than `max_chain_overlap` of the shorter
+/// one's extent, only the longest is kept.
+pub fn keep_longest(mut chains: Vec<Chain>, params: &QiuParams) -> Vec<Chain> {
+    chains.retain(|c| c.length_m() >= params.min_chain_m);
+    chains.sort_by(|a, b| {
+        b.length_m()
+            .total_cmp(&a.length_m())
+            .then(a.s[0].total_cmp(&b.s[0]))
+    });
+    let mut kept: Vec<Chain> = Vec::new();
+    for c in chains {
+        let (a0, a1) = c.s_range();
+        let ext = (a1 - a0).max(1e-9);
+        let overlaps = kept.iter().filter(|k| k.side == c.side).any(|k| {
+            let (b0, b1) = k.s_range();
+            (a1.min(b1) - a0.max(b0)).max(0.0) > params.max_chain_overlap * ext
+        });
+        if !overlaps {
+            kept.push(c);
+        }
+    }
+    kept.sort_by(|a, b| a.side.cmp(&b.side).then(a.s[0].total_cmp(&b.s[0])));
+    kept
+}
+
+/// §3.4.2 as a whole on the points kept by the width refinement: clusters per side, line
+/// segments per cluster, joined, longest kept.
+pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParams) -> Vec<Chain> {
+    let mut pieces = Vec::new();
+    for side in [Side::Left, Side::Right] {
+        let idx: Vec<usize> = kept
+            .iter()
+            .copied()
+            .filter(|&i| pts[i].side() == side)
+            .collect();
+        let xy: Vec<[f64; 2]> = idx.iter().map(|&i| [pts[i].p[0], pts[i].p[1]]).collect();
+        for cluster in euclidean_clusters(&xy, params.cluster_tolerance_m) {
+            if cluster.len() < params.min_cluster_points {
+                continue;
+            }
+            let members: Vec<usize> = cluster.iter().map(|&k| idx[k]).collect();
+            if let Some(c) = fit_segments(pts, &members, params) {
+                pieces.push(c);
+            }
+        }
+    }
+    keep_longest(join_chains(pieces, params), params)
+}
+
+/// Cuts a chain to the stations `[a, b]` (the section's core), interpolating a vertex
+/// where it crosses a bound (stations vary linearly along each segment); returns the pieces
+/// inside, each with at least two vertices.
+pub fn clip_to_stations(c: &Chain, a: f64, b: f64) -> Vec<Chain> {
+    let mut out = Vec::new();
+    let mut cur: Option<Chain> = None;
+    let at = |i: usize, w: f64| -> ([f64; 3], f64, f64) {
+        let j = (i + 1).min(c.pts.len() - 1);
+        let (p, q) = (c.pts[i], c.pts[j]);
+        (
+            [
+                p[0] + w * (q[0] - p[0]),
+                p[1] + w * (q[1] - p[1]),
+                p[2] + w * (q[2] - p[2]),
+            ],
+            c.s[i] + w * (c.s[j] - c.s[i]),
+            c.h[i] + w * (c.h[j] - c.h[i]),
+        )
+    };
+    let inside = |s: f64| s >= a && s <= b;
+    if c.pts.len() == 1 && inside(c.s[0]) {
+        return vec![c.clone()];
+    }
+    for i in 0..c.pts.len().saturating_sub(1) {
+        let (s0, s1) = (c.s[i], c.s[i + 1]);
+        // The part of the segment with a ≤ s ≤ b, as parameters w0 ≤ w1 in [0, 1].
+        let (w0, w1) = if (s1 - s0).abs() < 1e-12 {
+            if inside(s0) {
+                (0.0, 1.0)
+            } else {
+                (1.0, 0.0)
+            }
+        } else {
+            let wa = (a - s0) / (s1 - s0);
+            let wb = (b - s0) / (s1 - s0);
+            let (lo, hi) = if wa < wb { (wa, wb) } else { (wb, wa) };
+            (lo.max(0.0), hi.min(1.0))
+        };
+        if w0 > w1 {
+            if let Some(ch) = cur.take() {
+                out.push(ch);
+            }
+            continue;
+        }
+        let (p0, st0, h0) = at(i, w0);
+        let (p1, st1, h1) = at(i, w1);
+        // A segment that starts outside the range (w0 > 0) starts a new piece.
+        if w0 > 0.0 || cur.is_none() {
+            out.extend(cur.take());
+            cur = Some(Chain {
+                side: c.side,
+                pts: vec![p0],
+                s: vec![st0],
+                h: vec![h0],
+            });
+        }
+        if let Some(ch) = cur.as_mut() {
+            ch.pts.push(p1);
+            ch.s.push(st1);
+            ch.h.push(h1);
+        }
+        // A segment that ends outside the range (w1 < 1) ends the piece.
+        if w1 < 1.0 {
+            out.extend(cur.take());
+        }
+    }
+    out.extend(cur);
+    out.retain(|c| c.pts.len() >= 2);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ep(x: f64, y: f64) -> EdgePoint {
+        // Trajectory along the x axis, left = +y.
+        EdgePoint {
+            p: [x, y, 0.0],
+            s: x,
+            d: y,
+            foot: [x, 0.0],
+        }
+    }
+
+    #[test]
+    fn width_refinement_keeps_the_curbs_and_drops_a_wall_base() {
+        let p = QiuParams::default();
+        let mut pts = Vec::new();
+        // Curbs at ±5 m every 0.25 m over 20 m, a wall base at +8 m over the middle 10 m.
+        for k in 0..80 {
+            let x = k as f64 * 0.25;
+            pts.push(ep(x, 5.0));
+            pts.push(ep(x, -5.0));
+        }
+        for k in 0..40 {
+            pts.push(ep(5.0 + k as f64 * 0.25, 8.0));
+        }
+        let r = refine_by_width(&pts, &p);
+        // Every curb point pairs at 10 m: the histogram bin [10.0, 10.1) → centre 10.05.
+        assert!((r.road_width_m.unwrap() - 10.05).abs() < 1e-9);
+        assert_eq!(r.kept, (0..160).collect::<Vec<_>>());
+        // A left curb point with its right partner hidden (e.g. by a car) is kept by the
+        // offset agreement with its matched neighbours.
+        pts.retain(|q| !(q.d < 0.0 && (8.0..9.0).contains(&q.s)));
+        let r = refine_by_width(&pts, &p);
+        let kept_left_hidden = r
+            .kept
+            .iter()
+            .filter(|&&i| pts[i].d == 5.0 && (8.0..9.0).contains(&pts[i].s))
+            .count();
+        assert_eq!(kept_left_hidden, 4);
+        assert!(r.kept.iter().all(|&i| pts[i].d != 8.0));
+    }
+
+    #[test]
+    fn clusters_and_douglas_peucker() {
+        let xy = [[0.0, 0.0], [0.5, 0.0], [1.0, 0.0], [3.0, 0.0], [3.4, 0.3]];
+        assert_eq!(
+            euclidean_clusters(&xy, 0.6),
+            vec![vec![0, 1, 2], vec![3, 4]]
+        );
+        // An L: (0,0)–(2,0)–(2,2) sampled every 0.5 m; DP keeps the two ends and the corner.
+        let mut l: Vec<[f64; 3]> = (0..=4).map(|i| [i as f64 * 0.5, 0.0, 0.0]).collect();
+        l.extend((1..=4).map(|i| [2.0, i as f64 * 0.5, 0.0]));
+        assert_eq!(douglas_peucker(&l, 0.1), vec![0, 4, 8]);
+    }
+
+    #[test]
+    fn continuity_joins_a_gap_and_drops_short_pieces() {
+        let p = QiuParams::default();
+        let mut pts = Vec::new();
+        // Left curb y = 5 over [0, 10] and [13, 25] (a 3 m curb cut), a 1 m piece at y = 3.
+        for k in 0..=100 {
+            let x = k as f64 * 0.25;
+            if x <= 10.0 || x >= 13.0 {
+                pts.push(ep(x, 5.0));
+            }
+        }
+        for k in 0..=4 {
+            pts.push(ep(20.0 + k as f64 * 0.25, 3.0));
+        }
+        let kept: Vec<usize> = (0..pts.len()).collect();
+        let chains = refine_by_continuity(&pts, &kept, &p);
+        assert_eq!(chains.len(), 1, "{chains:?}");
+        let c = &chains[0];
+        assert_eq!(c.side, Side::Left);
+        // Bins of 0.5 m: medians span x ≈ 0.125 … 24.875 along y = 5.
+        assert!((c.length_m() - 24.75).abs() < 0.3, "{}", c.length_m());
+        assert!(c.pts.iter().all(|q| (q[1] - 5.0).abs() < 1e-9));
+    }
+
+    #[test]
+    fn clipping_cuts_at_the_core_bounds() {
+        let c = Chain {
+            side: Side::Right,
+            pts: vec![[0.0, -5.0, 0.0], [10.0, -5.0, 0.0], [20.0, -5.0, 0.0]],
+            s: vec![0.0, 10.0, 20.0],
+            h: vec![0.1, 0.2, 0.2],
+        };
+        // A single segment crossing the whole range is cut at both ends.
+        let one = Chain {
+            side: Side::Right,
+            pts: vec![[0.0, -5.0, 0.0], [20.0, -5.0, 0.0]],
+            s: vec![0.0, 20.0],
+            h: vec![0.1, 0.1],
+        };
+        let parts = clip_to_stations(&one, 5.0, 15.0);
+        assert_eq!(parts.len(), 1);
+        assert_eq!(parts[0].pts, vec![[5.0, -5.0, 0.0], [15.0, -5.0, 0.0]]);
+        let parts = clip_to_stations(&c, 5.0, 15.0);
+        assert_eq!(parts.len(), 1);
+        assert_eq!(
+            parts[0].pts,
+            vec![[5.0, -5.0, 0.0], [10.0, -5.0, 0.0], [15.0, -5.0, 0.0]]
+        );
+        // The height step at the cut is interpolated: halfway from 0.1 to 0.2.
+        assert!((parts[0].h[0] - 0.15).abs() < 1e-12);
+        // Two neighbouring cores give pieces that join back into one chain.
+        let mut pieces = clip_to_stations(&c, f64::NEG_INFINITY, 12.0);
+        pieces.extend(clip_to_stations(&c, 12.0, f64::INFINITY));
+        assert_eq!(pieces.len(), 2);
+        let joined = join_chains(pieces, &QiuParams::default());
+        assert_eq!(joined.len(), 1);
+        assert!((joined[0].length_m() - 20.0).abs() < 1e-9);
+        assert_eq!(joined[0].pts.len(), 4);
+    }
+}

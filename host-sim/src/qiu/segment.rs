@@ -1,0 +1,346 @@
+//! §3.3.2 Rough segmentation: a RANSAC rough plane Π₀ with threshold α (Eq. 1), refined
+//! planes Π_i from its inliers with thresholds β_i, candidate road-edge points (outliers of
+//! a refined plane with an inlier close by), and the choice among the candidate sets by the
+//! smoothness energy E_s (Eq. 2).
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::collections::HashMap;
+
+/// A plane n·p + c = 0 with |n| = 1 and n_z ≥ 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Plane {
+    /// Unit normal, pointing up.
+    pub n: [f64; 3],
+    /// Offset.
+    pub c: f64,
+}
+
+impl Plane {
+    /// Plane through three points, `None` when they are (nearly) collinear.
+    pub fn through(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> Option<Self> {
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let mut n = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        if len.is_nan() || len <= 1e-12 {
+            return None;
+        }
+        let s = if n[2] < 0.0 { -1.0 } else { 1.0 } / len;
+        n = [n[0] * s, n[1] * s, n[2] * s];
+        Some(Self {
+            n,
+            c: -(n[0] * a[0] + n[1] * a[1] + n[2] * a[2]),
+        })
+    }
+
+    /// Unsigned distance of a point (Eq. 1's D_i).
+    pub fn distance(&self, p: &[f64; 3]) -> f64 {
+        (self.n[0] * p[0] + self.n[1] * p[1] + self.n[2] * p[2] + self.c).abs()
+    }
+}
+
+/// RANSAC plane (Fischler & Bolles) over `pts[idx]`: the plane through three random points
+/// with the most points within `threshold`, among planes tilted at most `max_tilt_deg`.
+/// Returns the plane and the indices (into `pts`) of its inliers, in `idx` order; `None`
+/// with fewer than 3 points or no admissible plane.
+pub fn ransac_plane(
+    pts: &[[f64; 3]],
+    idx: &[usize],
+    threshold: f64,
+    iterations: usize,
+    max_tilt_deg: f64,
+    rng: &mut ChaCha8Rng,
+) -> Option<(Plane, Vec<usize>)> {
+    if idx.len() < 3 {
+        return None;
+    }
+    let min_nz = max_tilt_deg.to_radians().cos();
+    let mut best: Option<(Plane, usize)> = None;
+    for _ in 0..iterations {
+        let a = idx[rng.gen_range(0..idx.len())];
+        let b = idx[rng.gen_range(0..idx.len())];
+        let c = idx[rng.gen_range(0..idx.len())];
+        let Some(plane) = Plane::through(&pts[a], &pts[b], &pts[c]) else {
+            continue;
+        };
+        if plane.n[2] < min_nz {
+            continue;
+        }
+        let count = idx
+            .iter()
+            .filter(|&&i| plane.distance(&pts[i]) < threshold)
+            .count();
+        if best.is_none_or(|(_, n)| count > n) {
+            best = Some((plane, count));
+        }
+    }
+    let (plane, _) = best?;
+    let inliers = idx
+        .iter()
+        .copied()
+        .filter(|&i| plane.distance(&pts[i]) < threshold)
+        .collect();
+    Some((plane, inliers))
+}
+
+/// "We search inliers near an outlier. If there exist an inlier, then the outlier is
+/// considered to be a road edge point" (§3.3.2): of the points `rough` (the rough plane),
+/// those not in the refined plane (`is_refined[i] == false`) with a refined-plane point
+/// within `radius` (3D). Returns indices into `pts`, in `rough` order.
+pub fn candidate_edge_points(
+    pts: &[[f64; 3]],
+    rough: &[usize],
+    is_refined: &[bool],
+    radius: f64,
+) -> Vec<usize> {
+    let key = |p: &[f64; 3]| {
+        [
+            (p[0] / radius).floor() as i64,
+            (p[1] / radius).floor() as i64,
+            (p[2] / radius).floor() as i64,
+        ]
+    };
+    let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    for &i in rough.iter().filter(|&&i| is_refined[i]) {
+        grid.entry(key(&pts[i])).or_default().push(i);
+    }
+    let r2 = radius * radius;
+    rough
+        .iter()
+        .copied()
+        .filter(|&i| !is_refined[i])
+        .filter(|&i| {
+            let p = &pts[i];
+            let k = key(p);
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        if let Some(cell) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
+                            if cell.iter().any(|&j| {
+                                let q = &pts[j];
+                                (q[0] - p[0]).powi(2)
+                                    + (q[1] - p[1]).powi(2)
+                                    + (q[2] - p[2]).powi(2)
+                                    <= r2
+                            }) {
+                                return true;
+                            }
+                        }
+                    }
+                }
+            }
+            false
+        })
+        .collect()
+}
+
+/// Station bin over which the innermost candidate is taken for E_s, metres.
+const ENERGY_BIN_M: f64 = 0.5;
+
+/// The smoothness energy E_s of Eq. 2: the variance of the distances d(e_i, t_i) from
+/// candidate points to their nearest trajectory points. `pos` holds (station, signed
+/// offset) per candidate. Two readings the paper leaves open are fixed here:
+///
+/// - the variance is taken per side and summed: one variance over both sides would mostly
+///   measure how far the trajectory is from the road's middle;
+/// - it is the variance of the *innermost* candidate's distance per 0.5 m of station (the
+///   point Eq. 3 pairs as well). Over all candidates, a curb with a wall behind it would
+///   score worse than the wall alone (a two-valued mixture has a larger variance than
+///   either value), so the β that loses the curb would win; innermost per station, road
+///   noise (β too small) makes the line jump and scores badly, a clean curb line scores 0.
+///
+/// `None` when no side has two stations with candidates.
+pub fn smoothness_energy(pos: &[(f64, f64)]) -> Option<f64> {
+    let mut inner: [std::collections::BTreeMap<i64, f64>; 2] = Default::default();
+    for &(s, d) in pos {
+        let side = usize::from(d < 0.0);
+        let e = inner[side]
+            .entry((s / ENERGY_BIN_M).floor() as i64)
+            .or_insert(f64::INFINITY);
+        *e = e.min(d.abs());
+    }
+    let var = |m: &std::collections::BTreeMap<i64, f64>| -> Option<f64> {
+        if m.len() < 2 {
+            return None;
+        }
+        let n = m.len() as f64;
+        let mean = m.values().sum::<f64>() / n;
+        Some(m.values().map(|x| (x - mean).powi(2)).sum::<f64>() / n)
+    };
+    match (var(&inner[0]), var(&inner[1])) {
+        (None, None) => None,
+        (a, b) => Some(a.unwrap_or(0.0) + b.unwrap_or(0.0)),
+    }
+}
+
+/// The outcome of the rough segmentation of one section.
+#[derive(Clone, Debug, Default)]
+pub struct Segmentation {
+    /// Indices of the chosen candidate edge points.
+    pub candidates: Vec<usize>,
+    /// The β of the chosen set, metres (`None` when no set qualified).
+    pub beta_m: Option<f64>,
+    /// (β, number of candidates, E_s) for every refined plane, for reports and tests.
+    pub energies: Vec<(f64, usize, Option<f64>)>,
+}
+
+/// §3.3.2 as a whole on normalised points (`pts` with z replaced by height above the grid
+/// minimum). `position_of(i)` gives the station and signed offset of point `i` relative to
+/// its nearest trajectory point. Among sets with at least `min_candidates` points, the
+/// smallest β whose E_s is within `energy_tolerance` (relative, plus 0.01 m² absolute) of
+/// the smallest E_s wins: equally smooth sets differ only in how low a step they still
+/// see, and the smaller β sees lower curbs.
+#[allow(clippy::too_many_arguments)]
+pub fn rough_segmentation(
+    pts: &[[f64; 3]],
+    alpha: f64,
+    betas: &[f64],
+    iterations: usize,
+    max_tilt_deg: f64,
+    radius: f64,
+    min_candidates: usize,
+    energy_tolerance: f64,
+    seed: u64,
+    position_of: &dyn Fn(usize) -> Option<(f64, f64)>,
+) -> Segmentation {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let all: Vec<usize> = (0..pts.len()).collect();
+    let Some((_, rough)) = ransac_plane(pts, &all, alpha, iterations, max_tilt_deg, &mut rng)
+    else {
+        return Segmentation::default();
+    };
+    let mut out = Segmentation::default();
+    let mut sets: Vec<(f64, f64, Vec<usize>)> = Vec::new();
+    let mut is_refined = vec![false; pts.len()];
+    for &beta in betas {
+        let Some((_, refined)) =
+            ransac_plane(pts, &rough, beta, iterations, max_tilt_deg, &mut rng)
+        else {
+            out.energies.push((beta, 0, None));
+            continue;
+        };
+        is_refined.iter_mut().for_each(|f| *f = false);
+        for &i in &refined {
+            is_refined[i] = true;
+        }
+        let cand = candidate_edge_points(pts, &rough, &is_refined, radius);
+        let pos: Vec<(f64, f64)> = cand.iter().filter_map(|&i| position_of(i)).collect();
+        let e = smoothness_energy(&pos);
+        out.energies.push((beta, cand.len(), e));
+        if let Some(e) = e {
+            if cand.len() >= min_candidates {
+                sets.push((e, beta, cand));
+            }
+        }
+    }
+    let Some(e_min) = sets.iter().map(|s| s.0).min_by(f64::total_cmp) else {
+        return out;
+    };
+    let limit = e_min * (1.0 + energy_tolerance) + 0.01;
+    if let Some((_, beta, cand)) = sets
+        .into_iter()
+        .filter(|s| s.0 <= limit)
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+    {
+        out.beta_m = Some(beta);
+        out.candidates = cand;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ransac_finds_a_known_plane_among_clutter_deterministically() {
+        // 400 points on z = 0.1·x + 0.05·y + 1 (grid 0.25 m over 5 m × 5 m), 100 clutter
+        // points 1–3 m above it.
+        let mut pts = Vec::new();
+        for i in 0..20 {
+            for j in 0..20 {
+                let (x, y) = (i as f64 * 0.25, j as f64 * 0.25);
+                pts.push([x, y, 0.1 * x + 0.05 * y + 1.0]);
+            }
+        }
+        let mut r = ChaCha8Rng::seed_from_u64(7);
+        for _ in 0..100 {
+            let (x, y): (f64, f64) = (r.gen_range(0.0..5.0), r.gen_range(0.0..5.0));
+            pts.push([x, y, 0.1 * x + 0.05 * y + 1.0 + r.gen_range(1.0..3.0)]);
+        }
+        let idx: Vec<usize> = (0..pts.len()).collect();
+        let run = |seed| {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            ransac_plane(&pts, &idx, 0.01, 100, 20.0, &mut rng).unwrap()
+        };
+        let (plane, inl) = run(1);
+        assert_eq!(inl, (0..400).collect::<Vec<_>>());
+        // Normal of z = 0.1x + 0.05y + 1 is (−0.1, −0.05, 1)/√1.0125.
+        let k = 1.0125f64.sqrt();
+        assert!((plane.n[0] + 0.1 / k).abs() < 1e-9 && (plane.n[2] - 1.0 / k).abs() < 1e-9);
+        assert!((plane.c + 1.0 / k).abs() < 1e-9);
+        assert_eq!(run(1).0, plane, "same seed, same plane");
+    }
+
+    #[test]
+    fn a_steep_plane_is_not_taken_for_the_road() {
+        // A wall x = 0 (400 points, 1.9 m tall) beside a floor of as many points: the
+        // tilt guard makes RANSAC return the floor.
+        let mut pts = Vec::new();
+        for i in 0..20 {
+            for j in 0..20 {
+                pts.push([0.0, i as f64 * 0.1, j as f64 * 0.1]);
+            }
+        }
+        for i in 0..20 {
+            for j in 0..20 {
+                pts.push([0.2 + i as f64 * 0.1, j as f64 * 0.1, 0.0]);
+            }
+        }
+        let idx: Vec<usize> = (0..pts.len()).collect();
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let (plane, inl) = ransac_plane(&pts, &idx, 0.01, 200, 20.0, &mut rng).unwrap();
+        assert!(plane.n[2] > 0.999);
+        // The floor's 400 points and the wall's bottom row (z = 0, 20 points).
+        assert_eq!(inl.len(), 420);
+    }
+
+    #[test]
+    fn candidates_are_outliers_next_to_inliers() {
+        // Inliers (refined plane) at z = 0 for x = 0, 0.05, 0.10; outliers at x = 0.15
+        // (z = 0.05: 0.071 m from the inlier at x = 0.10) and at x = 0.5 (far).
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [0.05, 0.0, 0.0],
+            [0.10, 0.0, 0.0],
+            [0.15, 0.0, 0.05],
+            [0.5, 0.0, 0.15],
+        ];
+        let rough = [0, 1, 2, 3, 4];
+        let refined = [true, true, true, false, false];
+        assert_eq!(candidate_edge_points(&pts, &rough, &refined, 0.1), vec![3]);
+        assert!(candidate_edge_points(&pts, &rough, &refined, 0.05).is_empty());
+    }
+
+    #[test]
+    fn smoothness_energy_is_the_per_side_variance_of_the_innermost_line() {
+        // Left innermost offsets 4 and 6 at stations 0 and 1 (variance 1), right −5 twice
+        // (variance 0): E_s = 1. The extra left point at 7 m is behind the innermost.
+        let e = smoothness_energy(&[(0.1, 4.0), (0.2, 7.0), (1.1, 6.0), (0.1, -5.0), (1.1, -5.0)]);
+        assert_eq!(e, Some(1.0));
+        // A straight curb with a wall behind it scores 0; with road noise in front, more.
+        let curb_wall: Vec<(f64, f64)> = (0..10)
+            .flat_map(|k| [(k as f64, 5.0), (k as f64, 8.0)])
+            .collect();
+        assert_eq!(smoothness_energy(&curb_wall), Some(0.0));
+        let mut noisy = curb_wall.clone();
+        noisy.push((3.0, 1.0));
+        assert!(smoothness_energy(&noisy).unwrap() > 1.0);
+        assert_eq!(smoothness_energy(&[(0.0, 1.0)]), None);
+    }
+}

@@ -1,0 +1,484 @@
+//! The points, projected, encoded into the wire format and run through
+//! `curbtrace_core::pipeline::Pipeline` in-process: the same bytes the firmware would see
+//! (a config packet first, then point packets with the absolute GPS time in ns as each
+//! packet's base and the column index as each point's tag).
+//!
+//! # Parallel replay, identical output
+//!
+//! The core is a sequential stream. The points are cut into chunks of about
+//! [`ReplayParams::chunk_points`] points, each cut placed at a flagged line start (so no
+//! line is split between chunks), and each chunk runs through its own `Pipeline` with its own
+//! encoder. The cuts depend only on the data and the parameters, never on the number of
+//! threads; the scanline numbers of chunk c are offset by the lines of chunks 0..c. A
+//! pipeline starting at a flagged line start behaves as one that has been running (the
+//! kernel holds no state across lines), so the output is the same whatever the thread
+//! count. Without line flags ([`LineRule::None`]) the core's own split rule needs the
+//! previous line, so the stream runs as one chunk.
+
+use super::line_start::{LineRule, LineStartParams};
+use super::project::{project_point, PoseCursor};
+use crate::bend::{Candidate, STATUS_NOT_PROCESSED};
+use crate::io::las_in::PointColumns;
+use crate::io::trajectory::Trajectory;
+use crate::model::Side;
+use curbtrace_core::kernel::{Kernel, KernelParams, ScanlineOutput, CONFIG_WORDS};
+use curbtrace_core::scanline::{Ingest, IngestCounters, IngestEvent};
+use curbtrace_core::wire::{PointRecord, StreamEncoder, MAX_PACKET_LEN, MAX_POINTS_PER_PACKET};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::ops::Range;
+
+/// Capacity of the host pipeline's byte ring.
+pub const RING: usize = 1 << 16;
+/// Largest number of points of one scanline the host pipeline holds; more are counted as
+/// truncated by the core. A 360° scanner at 1 M pulses/s and 100 lines/s gives 10 000
+/// pulses per line; the simulator's VQ-250-like scanner 2 000.
+pub const LINE_CAPACITY: usize = 16_384;
+
+/// Stack size of the threads that run pipelines.
+pub const PIPELINE_STACK: usize = 64 << 20;
+
+/// The core's ingest (ring, parser, assembler) and kernel, composed as
+/// `docs/architecture.md` documents `Pipeline<RING, N>`: bytes in, one
+/// [`ScanlineOutput`] per completed line out; a config packet reconfigures the kernel.
+pub struct HostPipeline {
+    ingest: Ingest<RING, LINE_CAPACITY>,
+    kernel: Kernel<LINE_CAPACITY>,
+    config_rejected: u64,
+}
+
+impl Default for HostPipeline {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl HostPipeline {
+    /// A pipeline with the kernel's defaults until a config packet arrives.
+    pub fn new() -> Self {
+        Self {
+            ingest: Ingest::new(),
+            kernel: Kernel::new(KernelParams::DEFAULT),
+            config_rejected: 0,
+        }
+    }
+
+    /// Offers bytes; returns how many the ring took.
+    pub fn write(&mut self, bytes: &[u8]) -> usize {
+        self.ingest.write(bytes)
+    }
+
+    /// Processes every complete line in the ring.
+    pub fn run(&mut self, mut on_line: impl FnMut(&ScanlineOutput<'_>)) {
+        while let Some(ev) = self.ingest.poll() {
+            match ev {
+                IngestEvent::Config(words) => {
+                    let ok = KernelParams::from_words(&words)
+                        .ok()
+                        .and_then(|p| self.kernel.set_params(p).ok());
+                    if ok.is_none() {
+                        self.config_rejected += 1;
+                    }
+                }
+                IngestEvent::Line(line) => {
+                    let out = self.kernel.process(line);
+                    on_line(&out);
+                }
+            }
+        }
+    }
+
+    /// End of stream: the partial last line is processed too.
+    pub fn finish(&mut self, on_line: impl FnMut(&ScanlineOutput<'_>)) {
+        self.ingest.finish();
+        self.run(on_line);
+    }
+
+    /// The ingest counters.
+    pub fn counters(&self) -> IngestCounters {
+        self.ingest.counters()
+    }
+
+    /// Config packets whose parameters the kernel refused (the old ones stayed).
+    pub fn config_rejected(&self) -> u64 {
+        self.config_rejected
+    }
+}
+
+/// Parameters of the replay (`[replay]` in the config file).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ReplayParams {
+    /// Smallest backward jump of the scan angle taken as the wrap between two lines,
+    /// degrees (see [`LineStartParams::wrap_min_deg`]).
+    pub wrap_min_deg: f32,
+    /// Line period in seconds for files without scan angles (0 = unknown: the core splits).
+    pub line_period_s: f64,
+    /// Points per chunk for the parallel replay (cut at the next line start). Larger
+    /// chunks mean fewer pipelines; smaller ones balance threads better. 2^18 keeps the
+    /// two cores here busy on 5 M points with 20 chunks.
+    pub chunk_points: usize,
+}
+
+impl Default for ReplayParams {
+    fn default() -> Self {
+        let l = LineStartParams::default();
+        Self {
+            wrap_min_deg: l.wrap_min_deg,
+            line_period_s: l.line_period_s,
+            chunk_points: 1 << 18,
+        }
+    }
+}
+
+impl ReplayParams {
+    /// The line-start part.
+    pub fn line(&self) -> LineStartParams {
+        LineStartParams {
+            wrap_min_deg: self.wrap_min_deg,
+            line_period_s: self.line_period_s,
+        }
+    }
+}
+
+/// Errors of the replay.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    /// A point lies outside the trajectory (the caller drops those first).
+    #[error("point {index} at GPS time {t} s is outside the trajectory")]
+    Uncovered {
+        /// Column index.
+        index: usize,
+        /// Its time.
+        t: f64,
+    },
+    /// Negative GPS times cannot be carried as the wire's unsigned ns.
+    #[error(
+        "point {index} has a negative GPS time {t} s; the wire carries GPS time as unsigned ns"
+    )]
+    NegativeTime {
+        /// Column index.
+        index: usize,
+        /// Its time.
+        t: f64,
+    },
+    /// The core's encoder refused a packet (a bug, reported rather than hidden).
+    #[error("encoding a packet failed: {0:?}")]
+    Encode(curbtrace_core::wire::EncodeError),
+    /// The pipeline stopped accepting bytes.
+    #[error("the core's ring accepted no bytes after processing every line (stalled)")]
+    Stalled,
+    /// The output writer failed.
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+}
+
+/// Counters over the whole replay, summed over chunks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ReplayCounters {
+    /// Points sent to the core.
+    pub points_sent: u64,
+    /// Scanlines the core completed.
+    pub scanlines: u64,
+    /// Points with status Kept.
+    pub kept: u64,
+    /// Points removed as irregular (§2.4).
+    pub irregular: u64,
+    /// Points without a neighbour on one side.
+    pub no_neighbour: u64,
+    /// Points dropped because their line was over [`LINE_CAPACITY`].
+    pub truncated: u64,
+    /// Points sent that never came back from the core (ingest drops: counted by the core).
+    pub lost: u64,
+    /// Wire packets sent (config packets included).
+    pub packets: u64,
+    /// Bytes sent.
+    pub bytes: u64,
+}
+
+impl ReplayCounters {
+    fn add(&mut self, o: &ReplayCounters) {
+        self.points_sent += o.points_sent;
+        self.scanlines += o.scanlines;
+        self.kept += o.kept;
+        self.irregular += o.irregular;
+        self.no_neighbour += o.no_neighbour;
+        self.truncated += o.truncated;
+        self.lost += o.lost;
+        self.packets += o.packets;
+        self.bytes += o.bytes;
+    }
+}
+
+/// The core's results per source point, and its seed candidates.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct KernelResults {
+    /// ρ on the smoothed line, degrees (0 unless kept).
+    pub rho_deg: Vec<f32>,
+    /// `PointStatus as u8`, or [`STATUS_NOT_PROCESSED`].
+    pub status: Vec<u8>,
+    /// Global scanline number (`u32::MAX` when not processed).
+    pub scanline: Vec<u32>,
+    /// Seed candidates, in scanline order.
+    pub candidates: Vec<Candidate>,
+    /// Counters.
+    pub counters: ReplayCounters,
+}
+
+/// The chunk ranges (cut at line starts, independent of the thread count).
+pub fn chunks(cols: &PointColumns, rule: &LineRule, chunk_points: usize) -> Vec<Range<usize>> {
+    let n = cols.len();
+    if !rule.flags_lines() || n == 0 {
+        return vec![0..n];
+    }
+    let mut out = Vec::new();
+    let mut a = 0;
+    while a < n {
+        let mut b = (a + chunk_points.max(1)).min(n);
+        while b < n && !rule.is_start(b, &cols.scan_angle_deg, &cols.t) {
+            b += 1;
+        }
+        out.push(a..b);
+        a = b;
+    }
+    out
+}
+
+fn ns_of(t: f64, index: usize) -> Result<u64, ReplayError> {
+    if t < 0.0 {
+        return Err(ReplayError::NegativeTime { index, t });
+    }
+    Ok((t * 1e9).round() as u64)
+}
+
+/// Encodes the points `range` into the wire stream: a config packet with `words`, then
+/// point packets of up to `MAX_POINTS_PER_PACKET` points. Each packet's base time is its
+/// first point's GPS time in ns; a packet is closed early when the next point's offset would
+/// not fit `dt_ns: u32` (4.29 s). Calls `sink` with every packet's bytes.
+pub fn encode_stream(
+    cols: &PointColumns,
+    range: Range<usize>,
+    traj: &Trajectory,
+    words: &[u32; CONFIG_WORDS],
+    rule: &LineRule,
+    sink: &mut dyn FnMut(&[u8]) -> Result<(), ReplayError>,
+) -> Result<(), ReplayError> {
+    let mut enc = StreamEncoder::new();
+    let mut buf = vec![0u8; MAX_PACKET_LEN];
+    let n = enc
+        .encode_config(words, &mut buf)
+        .map_err(ReplayError::Encode)?;
+    sink(&buf[..n])?;
+    let mut cur = PoseCursor::new(traj);
+    let mut recs: Vec<PointRecord> = Vec::with_capacity(MAX_POINTS_PER_PACKET);
+    let mut base_ns = 0u64;
+    for i in range {
+        let t = cols.t[i];
+        let t_ns = ns_of(t, i)?;
+        let (xp, zp) = project_point(&mut cur, cols.x[i], cols.y[i], cols.z[i], t)
+            .ok_or(ReplayError::Uncovered { index: i, t })?;
+        let dt = t_ns
+            .checked_sub(base_ns)
+            .and_then(|d| u32::try_from(d).ok());
+        let dt = match dt {
+            Some(d) if !recs.is_empty() && recs.len() < MAX_POINTS_PER_PACKET => d,
+            _ => {
+                if !recs.is_empty() {
+                    let m = enc
+                        .encode_points(base_ns, &recs, &mut buf)
+                        .map_err(ReplayError::Encode)?;
+                    sink(&buf[..m])?;
+                    recs.clear();
+                }
+                base_ns = t_ns;
+                0
+            }
+        };
+        recs.push(PointRecord {
+            dt_ns: dt,
+            x_m: xp as f32,
+            z_m: zp as f32,
+            intensity: cols.intensity[i],
+            line_start: rule.is_start(i, &cols.scan_angle_deg, &cols.t),
+            tag: i as u32,
+        });
+    }
+    if !recs.is_empty() {
+        let m = enc
+            .encode_points(base_ns, &recs, &mut buf)
+            .map_err(ReplayError::Encode)?;
+        sink(&buf[..m])?;
+    }
+    Ok(())
+}
+
+/// One chunk's results, before the scanline numbers are made global.
+struct ChunkOut {
+    lines: u32,
+    candidates: Vec<Candidate>,
+    counters: ReplayCounters,
+}
+
+fn run_chunk(
+    cols: &PointColumns,
+    range: Range<usize>,
+    traj: &Trajectory,
+    words: &[u32; CONFIG_WORDS],
+    rule: &LineRule,
+    rho: &mut [f32],
+    status: &mut [u8],
+    line: &mut [u32],
+) -> Result<ChunkOut, ReplayError> {
+    let start = range.start;
+    let mut pipe: Box<HostPipeline> = Box::default();
+    let mut out = ChunkOut {
+        lines: 0,
+        candidates: Vec::new(),
+        counters: ReplayCounters::default(),
+    };
+    let mut collect = |o: &ScanlineOutput<'_>, out: &mut ChunkOut| {
+        out.lines = out.lines.max(o.index.saturating_add(1));
+        out.counters.scanlines += 1;
+        out.counters.truncated += u64::from(o.truncated);
+        for (k, &tag) in o.tag.iter().enumerate() {
+            let Some(j) = (tag as usize).checked_sub(start).filter(|&j| j < rho.len()) else {
+                continue;
+            };
+            rho[j] = o.rho_deg[k];
+            status[j] = o.status[k] as u8;
+            line[j] = o.index;
+        }
+        out.counters.kept += u64::from(o.counters.kept);
+        out.counters.irregular += u64::from(o.counters.irregular);
+        out.counters.no_neighbour += u64::from(o.counters.no_neighbour);
+        for (idx, side) in [(o.left, Side::Left), (o.right, Side::Right)] {
+            if let Some(&tag) = idx.and_then(|k| o.tag.get(usize::from(k))) {
+                out.candidates.push(Candidate {
+                    point: tag,
+                    side,
+                    scanline: o.index,
+                });
+            }
+        }
+    };
+    let mut packets = 0u64;
+    let mut bytes = 0u64;
+    encode_stream(cols, range.clone(), traj, words, rule, &mut |b: &[u8]| {
+        packets += 1;
+        bytes += b.len() as u64;
+        let mut off = 0;
+        while off < b.len() {
+            let w = pipe.write(&b[off..]);
+            off += w;
+            pipe.run(|o| collect(o, &mut out));
+            if w == 0 && off < b.len() {
+                // The ring is full and processing every complete line freed nothing.
+                let w2 = pipe.write(&b[off..]);
+                if w2 == 0 {
+                    return Err(ReplayError::Stalled);
+                }
+                off += w2;
+            }
+        }
+        Ok(())
+    })?;
+    pipe.finish(|o| collect(o, &mut out));
+    out.counters.packets = packets;
+    out.counters.bytes = bytes;
+    out.counters.points_sent = range.len() as u64;
+    Ok(out)
+}
+
+/// Runs every point of `cols` (all inside `traj`'s time range) through the core and
+/// collects its results per point. `progress` is called with points done so far.
+pub fn run_kernel(
+    cols: &PointColumns,
+    traj: &Trajectory,
+    words: &[u32; CONFIG_WORDS],
+    params: &ReplayParams,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<KernelResults, ReplayError> {
+    let n = cols.len();
+    let rule = LineRule::choose(&cols.scan_angle_deg, &cols.t, &params.line());
+    let ranges = chunks(cols, &rule, params.chunk_points);
+    let mut rho = vec![0f32; n];
+    let mut status = vec![STATUS_NOT_PROCESSED; n];
+    let mut scanline = vec![u32::MAX; n];
+    // Disjoint output slices per chunk.
+    let mut parts = Vec::with_capacity(ranges.len());
+    {
+        let (mut r, mut s, mut l) = (&mut rho[..], &mut status[..], &mut scanline[..]);
+        for rg in &ranges {
+            let (r1, r2) = r.split_at_mut(rg.len());
+            let (s1, s2) = s.split_at_mut(rg.len());
+            let (l1, l2) = l.split_at_mut(rg.len());
+            parts.push((rg.clone(), r1, s1, l1));
+            (r, s, l) = (r2, s2, l2);
+        }
+    }
+    let done = std::sync::atomic::AtomicU64::new(0);
+    // A pool of our own: a pipeline holds a few MB of fixed buffers, more than rayon's
+    // default 2 MiB worker stacks take in a debug build.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(rayon::current_num_threads())
+        .stack_size(PIPELINE_STACK)
+        .build()
+        .map_err(|e| ReplayError::Io(std::io::Error::other(e)))?;
+    let outs: Vec<Result<ChunkOut, ReplayError>> = pool.install(|| {
+        parts
+            .into_par_iter()
+            .map(|(rg, r, s, l)| {
+                let len = rg.len() as u64;
+                let o = run_chunk(cols, rg, traj, words, &rule, r, s, l);
+                let d = done.fetch_add(len, std::sync::atomic::Ordering::Relaxed) + len;
+                progress(d);
+                o
+            })
+            .collect()
+    });
+    let mut counters = ReplayCounters::default();
+    let mut candidates = Vec::new();
+    let mut bases = Vec::with_capacity(outs.len());
+    let mut base = 0u32;
+    for o in outs {
+        let o = o?;
+        bases.push(base);
+        counters.add(&o.counters);
+        candidates.extend(o.candidates.into_iter().map(|c| Candidate {
+            scanline: c.scanline + base,
+            ..c
+        }));
+        base = base.saturating_add(o.lines);
+    }
+    // Make the per-point scanline numbers global, chunk by chunk.
+    let mut rest = &mut scanline[..];
+    let mut slices = Vec::with_capacity(ranges.len());
+    for rg in &ranges {
+        let (a, b) = rest.split_at_mut(rg.len());
+        slices.push(a);
+        rest = b;
+    }
+    slices
+        .into_par_iter()
+        .zip(bases.par_iter())
+        .for_each(|(sl, &b)| {
+            if b > 0 {
+                sl.iter_mut()
+                    .filter(|v| **v != u32::MAX)
+                    .for_each(|v| *v += b);
+            }
+        });
+    let returned = status
+        .iter()
+        .filter(|&&s| s != STATUS_NOT_PROCESSED)
+        .count() as u64;
+    counters.lost =
+        counters.points_sent - returned - counters.truncated.min(counters.points_sent - returned);
+    Ok(KernelResults {
+        rho_deg: rho,
+        status,
+        scanline,
+        candidates,
+        counters,
+    })
+}
