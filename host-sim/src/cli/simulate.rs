@@ -31,7 +31,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .with_context(|| format!("simulating scene {}", args.scene))?;
     let [curb, cut, inter, bay] = s.reference_m;
     println!(
-        "{}: {} points, {} lines, {:.1} m driven in {:.1} s, reference {:.1} m (curb {:.1}, curb_cut {:.1}, intersection {:.1}, bus_bay {:.1}); {:.1} s wall",
+        "{}: {} points, {} lines, {:.1} m driven in {:.1} s, reference {:.1} m (curb {:.1}, curb_cut {:.1}, intersection {:.1}, bus_bay {:.1}); {:.1} s wall ({:.1} s simulating, {:.1} s writing)",
         s.scene,
         s.points,
         s.lines,
@@ -42,7 +42,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         cut,
         inter,
         bay,
-        s.elapsed_s
+        s.elapsed_s,
+        s.simulate_s,
+        s.write_s
     );
     println!(
         "wrote {}, {}, {}",

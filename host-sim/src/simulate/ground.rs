@@ -90,7 +90,7 @@ pub struct ToeLine {
     pub h_walk: Vec<f64>,
     /// Category of the stretch at each vertex.
     pub category: Vec<crate::model::Category>,
-    /// Half the road width here: where the cross slope reaches the crown, metres.
+    /// Distance from the toe at which the cross slope stops rising (the crown), metres.
     pub crown_m: f64,
 }
 
@@ -135,8 +135,10 @@ pub struct Ground {
     y0: f64,
     nx: usize,
     ny: usize,
-    /// (nx + 1) × (ny + 1) nodes: height minus base.
+    /// (nx + 1) × (ny + 1) nodes: the full height (used in far cells).
     node: Vec<f32>,
+    /// (nx + 1) × (ny + 1) nodes: the base surface (smooth; bilinear error ~µm).
+    base_node: Vec<f32>,
     /// Per cell: u32::MAX = far (use the raster), else index into `near`.
     cell: Vec<u32>,
     /// (start, end) into `cand` per near cell.
@@ -155,11 +157,12 @@ pub fn step_profile(shape: &CurbShape, s: f64, hc: f64, hw: f64) -> f64 {
     let b = shape.batter_ratio * hc;
     let r = shape.top_radius_m.min(0.4 * hc);
     // The face rises at angle alpha; a fillet of radius r tangent to face and top has its
-    // tangent points T = r·tan(alpha/2) from the corner (b, hc) along each line.
-    let alpha = hc.atan2(b);
-    let tt = r * (alpha * 0.5).tan();
+    // tangent points T = r·tan(alpha/2) from the corner (b, hc) along each line, with
+    // tan(alpha/2) = hc / (L + b) and cos alpha = b / L for the face length L.
+    let l = (hc * hc + b * b).sqrt();
+    let tt = r * hc / (l + b);
     let sc = b + tt;
-    let face_end = b - tt * alpha.cos();
+    let face_end = b - tt * b / l;
     if s < face_end {
         hc * s / b
     } else if s < sc {
@@ -290,7 +293,15 @@ impl Ground {
                 let y = ymin + j as f64 * CELL_M;
                 (0..(nx + 1)).map(move |i| (xmin + i as f64 * CELL_M, y))
             })
-            .map(|(x, y)| exact(x, y) as f32)
+            .map(|(x, y)| (exact(x, y) + base.at(x, y)) as f32)
+            .collect();
+        let base_node: Vec<f32> = (0..(ny + 1))
+            .into_par_iter()
+            .flat_map_iter(|j| {
+                let y = ymin + j as f64 * CELL_M;
+                (0..(nx + 1)).map(move |i| (xmin + i as f64 * CELL_M, y))
+            })
+            .map(|(x, y)| base.at(x, y) as f32)
             .collect();
         let half_diag = CELL_M * std::f64::consts::FRAC_1_SQRT_2;
         let lists: Vec<Option<Vec<u32>>> = (0..nx * ny)
@@ -340,6 +351,7 @@ impl Ground {
             nx,
             ny,
             node,
+            base_node,
             cell,
             near,
             cand,
@@ -369,18 +381,20 @@ impl Ground {
         if ix >= self.nx || iy >= self.ny {
             return None;
         }
-        let b = self.base.at(x, y);
         let c = self.cell[iy * self.nx + ix];
+        let (u, v) = (fx - ix as f64, fy - iy as f64);
+        let w = self.nx + 1;
+        let k = iy * w + ix;
+        let bil = |g: &[f32]| {
+            g[k] as f64 * (1.0 - u) * (1.0 - v)
+                + g[k + 1] as f64 * u * (1.0 - v)
+                + g[k + w] as f64 * (1.0 - u) * v
+                + g[k + w + 1] as f64 * u * v
+        };
         if c == u32::MAX {
-            let (u, v) = (fx - ix as f64, fy - iy as f64);
-            let w = self.nx + 1;
-            let n = |i: usize, j: usize| self.node[j * w + i] as f64;
-            let h = n(ix, iy) * (1.0 - u) * (1.0 - v)
-                + n(ix + 1, iy) * u * (1.0 - v)
-                + n(ix, iy + 1) * (1.0 - u) * v
-                + n(ix + 1, iy + 1) * u * v;
-            return Some((b + h, None));
+            return Some((bil(&self.node), None));
         }
+        let b = bil(&self.base_node);
         let (s0, s1) = self.near[c as usize];
         let mut best = (f64::INFINITY, 0.0, 0.0, 0usize);
         for &i in &self.cand[s0 as usize..s1 as usize] {
@@ -441,16 +455,49 @@ impl Ground {
             let tn = (t + step).min(t1);
             let gn = g_at(tn)?;
             if gn <= 0.0 {
-                // Bisect the sign change.
-                let (mut lo, mut hi) = (t, tn);
-                for _ in 0..40 {
-                    let mid = 0.5 * (lo + hi);
-                    match g_at(mid) {
-                        Some(v) if v > 0.0 => lo = mid,
-                        _ => hi = mid,
-                    }
+                // Regula falsi (Illinois variant) on the bracketed sign change: a few
+                // evaluations on smooth ground, still safe across the curb's kinks.
+                let (mut lo, mut hi, mut glo, mut ghi) = (t, tn, g, gn);
+                let mut side = 0i8;
+                for _ in 0..60 {
                     if hi - lo < 1e-4 {
                         break;
+                    }
+                    let mut mid = lo + (hi - lo) * glo / (glo - ghi);
+                    if !(mid > lo && mid < hi) {
+                        mid = 0.5 * (lo + hi);
+                    }
+                    match g_at(mid) {
+                        Some(v) if v > 0.0 => {
+                            if v < 2e-5 {
+                                lo = mid;
+                                hi = mid;
+                                break;
+                            }
+                            lo = mid;
+                            glo = v;
+                            if side == 1 {
+                                ghi *= 0.5;
+                            }
+                            side = 1;
+                        }
+                        Some(v) => {
+                            if v > -2e-5 {
+                                lo = mid;
+                                hi = mid;
+                                break;
+                            }
+                            hi = mid;
+                            ghi = v;
+                            if side == -1 {
+                                glo *= 0.5;
+                            }
+                            side = -1;
+                        }
+                        None => {
+                            hi = mid;
+                            ghi = -1e-3;
+                        }
                     }
                 }
                 let th = 0.5 * (lo + hi);

@@ -9,8 +9,18 @@
 //! | [`prims`] | walls, fences, parked cars, poles, weeds, leaves, and the ray walk through them |
 //! | [`drive`] | the vehicle's path, speed and attitude → the 200 Hz trajectory |
 //! | [`scanner`] | the VQ-250-like profiler: pulse directions and timing, noise, intensity |
-//! | [`reference`] | the visibility rule and the reference lines |
-//! | [`write`] | LAS 1.4 / LAZ and the trajectory CSV |
+//! | [`reference`](mod@reference) | the visibility rule and the reference lines |
+//! | [`write`](mod@write) | LAS 1.4 / LAZ and the trajectory CSV |
+//!
+//! Physics in one paragraph: a full-circle profiler (100 lines/s, 2000 pulses/line, 2 m
+//! above the road, scan plane yawed 45° and tilted 40°, see [`scanner`]) fires every pulse
+//! at its own time from the pose interpolated at that time; a pulse returns from the first
+//! surface it meets — the exact ground with its curbs ([`ground`]) or an object
+//! ([`prims`]) — with Gaussian range noise (σ 5 mm) and rare outliers (2·10⁻⁴, up to metres
+//! off); pulses into the sky, nearer than 1.5 m, or into the vehicle's own body return
+//! nothing. Intensity is Lambertian with material reflectance and speckle. The scan angle
+//! (degrees in the scan plane from its lowest direction, −180° at the top where a line
+//! starts) is stored rounded to LAS units. The reference rule is in [`reference`](mod@reference).
 //!
 //! Determinism: every scan line draws its noise from its own generator seeded by
 //! `(seed, line number)`, and lines are gathered in order, so the output is identical for
@@ -117,6 +127,10 @@ pub struct SimSummary {
     pub reference_m: [f64; 4],
     /// Wall-clock seconds for the whole run.
     pub elapsed_s: f64,
+    /// Of which building the world and casting the rays.
+    pub simulate_s: f64,
+    /// Of which writing the files.
+    pub write_s: f64,
     /// `points.laz`.
     pub points_path: PathBuf,
     /// `trajectory.csv`.
@@ -215,6 +229,7 @@ pub fn run(
         source,
     })?;
     let sim = simulate(spec, seed, speed_kmh, progress)?;
+    let simulate_s = start.elapsed().as_secs_f64();
     let origin = sim.world.spec.origin;
     let points_path = out_dir.join("points.laz");
     let trajectory_path = out_dir.join("trajectory.csv");
@@ -243,6 +258,8 @@ pub fn run(
         duration_s: sim.scan.1 - sim.scan.0,
         reference_m,
         elapsed_s: start.elapsed().as_secs_f64(),
+        simulate_s,
+        write_s: start.elapsed().as_secs_f64() - simulate_s,
         points_path,
         trajectory_path,
         reference_path,
@@ -456,5 +473,108 @@ mod tests {
             "{e}"
         );
         assert!(simulate(&east_spec(1.0), 1, Some(0.0), false).is_err());
+    }
+}
+
+/// Pictures for a person checking the simulator by eye (`cargo test … -- --ignored`):
+/// top views around a scene's features from a written `points.laz` and reference.
+#[cfg(test)]
+mod views {
+    use super::*;
+    use plotters::prelude::*;
+
+    fn render(scene: &str, dir: &str, centers: &[(f64, f64)], half_m: f64) {
+        let spec = scene_by_name(scene).unwrap();
+        let world = World::build(spec.clone(), 1);
+        let o = spec.origin;
+        let mut r = las::Reader::from_path(format!("{dir}/points.laz")).unwrap();
+        let pd = r.read_all().unwrap();
+        let pts: Vec<[f64; 3]> = pd
+            .x()
+            .zip(pd.y())
+            .zip(pd.z())
+            .map(|((x, y), z)| [x - o[0], y - o[1], z - o[2]])
+            .collect();
+        let (refl, _) =
+            crate::model::read_geojson(std::path::Path::new(&format!("{dir}/reference.geojson")))
+                .unwrap();
+        for (k, &(u, v)) in centers.iter().enumerate() {
+            let c = world.center.map(u, v);
+            let px = 800u32;
+            let sc = px as f64 / (2.0 * half_m);
+            let path = format!("/tmp/sim_views/{scene}_{k}_u{u:.0}.png");
+            std::fs::create_dir_all("/tmp/sim_views").unwrap();
+            let root = BitMapBackend::new(&path, (px, px)).into_drawing_area();
+            root.fill(&BLACK).unwrap();
+            let to_px = |x: f64, y: f64| {
+                (
+                    ((x - c[0] + half_m) * sc) as i32,
+                    ((c[1] + half_m - y) * sc) as i32,
+                )
+            };
+            for p in &pts {
+                if (p[0] - c[0]).abs() > half_m || (p[1] - c[1]).abs() > half_m {
+                    continue;
+                }
+                let h = p[2] - world.ground.base.at(p[0], p[1]);
+                let f = ((h + 0.05) / 0.45).clamp(0.0, 1.0);
+                let col = if h > 0.5 {
+                    RGBColor(90, 90, 90)
+                } else {
+                    RGBColor(
+                        (255.0 * f) as u8,
+                        (255.0 * (1.0 - (2.0 * f - 1.0).abs())) as u8,
+                        (255.0 * (1.0 - f)) as u8,
+                    )
+                };
+                root.draw_pixel(to_px(p[0], p[1]), &col).unwrap();
+            }
+            for l in &refl {
+                let col = if l.side == crate::model::Side::Left {
+                    RED
+                } else {
+                    WHITE
+                };
+                let col = match l.category {
+                    Some(Category::CurbCut) => MAGENTA,
+                    Some(Category::Intersection) => YELLOW,
+                    Some(Category::BusBay) => CYAN,
+                    _ => col,
+                };
+                let pts: Vec<_> = l
+                    .points
+                    .iter()
+                    .map(|p| to_px(p[0] - o[0], p[1] - o[1]))
+                    .collect();
+                root.draw(&PathElement::new(pts, col.stroke_width(1)))
+                    .unwrap();
+            }
+            root.present().unwrap();
+        }
+    }
+
+    #[test]
+    #[ignore]
+    fn render_views() {
+        let which = std::env::var("SIM_VIEW").unwrap_or_else(|_| "tiny".into());
+        let dir = format!("/tmp/sim_{which}");
+        let centers: Vec<(f64, f64)> = match which.as_str() {
+            "kawasaki" => vec![
+                (52.0, 4.0),
+                (95.0, 8.0),
+                (125.0, 4.0),
+                (215.0, 5.0),
+                (255.0, -8.0),
+                (175.0, 0.0),
+            ],
+            "sapporo" => vec![(120.0, 6.0), (222.0, 0.0), (275.0, -8.0), (95.0, -3.0)],
+            "curvy" => vec![(120.0, 0.0), (60.0, -3.0)],
+            _ => vec![(15.0, 0.0)],
+        };
+        render(&which, &dir, &centers, 15.0);
+        if which == "kawasaki" {
+            // Close-ups: weeds and leaves at the left curb; a parked car hiding the curb.
+            render(&which, &dir, &[(30.0, 5.0), (68.0, 4.5)], 3.0);
+        }
     }
 }

@@ -282,6 +282,8 @@ pub struct Objects {
     ny: usize,
     ranges: Vec<(u32, u32)>,
     ids: Vec<u32>,
+    /// Highest point of any object: rays climbing above it can stop.
+    z_top: f64,
 }
 
 impl Objects {
@@ -303,6 +305,14 @@ impl Objects {
                 }
             }
         }
+        let z_top = prims
+            .iter()
+            .map(|p| match p.shape {
+                Shape::Box { c, half, .. } | Shape::RoundBox { c, half, .. } => c[2] + half[2],
+                Shape::Cyl { z, .. } => z[1],
+                Shape::Disc { c, .. } => c[2],
+            })
+            .fold(f64::NEG_INFINITY, f64::max);
         let mut ranges = Vec::with_capacity(lists.len());
         let mut ids = Vec::new();
         for l in lists {
@@ -319,12 +329,24 @@ impl Objects {
             ny,
             ranges,
             ids,
+            z_top,
         }
     }
 
     /// Nearest hit of the ray `o + t·d` with `t ∈ (tmin, tmax)`.
     pub fn intersect(&self, o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64) -> Option<Hit> {
         let mut best: Option<Hit> = None;
+        // A climbing ray above every object's top can hit nothing more.
+        let tmax = if d[2] > 1e-12 {
+            tmax.min((self.z_top - o[2]) / d[2])
+        } else if o[2] > self.z_top {
+            return None;
+        } else {
+            tmax
+        };
+        if tmax <= tmin {
+            return None;
+        }
         let mut tbest = tmax;
         let test_cell = |ci: usize, tb: &mut f64, best: &mut Option<Hit>| {
             let (s, e) = self.ranges[ci];

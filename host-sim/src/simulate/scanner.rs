@@ -128,11 +128,12 @@ pub fn mount_directions(cfg: &ScannerConfig) -> Vec<[f64; 3]> {
 }
 
 /// Whether a body-frame direction from the scanner hits the vehicle itself: such pulses
-/// give no return. The scanner head sits on a rear platform 0.3 m behind the body and 0.4 m
-/// above its roof; the body is a box 4.5 m long and 1.9 m wide down to the ground.
+/// give no return. The scanner head sits on a rear platform 0.3 m behind the body and 0.5 m
+/// above its roof; the body is a box 4.5 m long and 1.9 m wide down to the ground. This
+/// shades a narrow strip of road about 3.5 m to the right of the path, as real rigs do.
 pub fn hits_own_vehicle(d: [f64; 3], height_m: f64) -> bool {
     let lo = [0.3, -0.95, -height_m];
-    let hi = [4.8, 0.95, -0.4];
+    let hi = [4.8, 0.95, -0.5];
     let mut t0 = 0.0f64;
     let mut t1 = f64::INFINITY;
     for k in 0..3 {

@@ -171,9 +171,9 @@ pub struct SceneSpec {
     pub drive: (f64, f64),
     /// Default speed, km/h.
     pub speed_kmh: f64,
-    /// Road half widths `(u, left, right)`, linear between rows.
+    /// Road half widths `(u, left, right)`, smooth (cosine) transitions between rows.
     pub half_width: Vec<(f64, f64, f64)>,
-    /// Curb heights `(u, left, right)`, linear between rows.
+    /// Curb heights `(u, left, right)`, smooth (cosine) transitions between rows.
     pub curb_h: Vec<(f64, f64, f64)>,
     /// Distance of the vehicle's path from the left curb, metres (left-hand traffic).
     pub lane_from_left_m: f64,
@@ -214,7 +214,9 @@ fn interp(table: &[(f64, f64, f64)], u: f64, side: Side) -> f64 {
         return pick(&table[table.len() - 1]);
     }
     let (a, b) = (&table[k - 1], &table[k]);
-    let w = (u - a.0) / (b.0 - a.0);
+    // Smooth (cosine) transitions: real tapers have no kinks, and the lane that follows
+    // them must not make the vehicle jerk.
+    let w = smooth01((u - a.0) / (b.0 - a.0));
     pick(a) + (pick(b) - pick(a)) * w
 }
 
@@ -378,7 +380,7 @@ const PASS_CLEARANCE_M: f64 = 0.95 + 0.6;
 
 impl World {
     /// Lateral position `v` of the vehicle's path at `u`: its lane, swerving out around
-    /// parked cars on its own side with smooth 12 m transitions.
+    /// parked cars on its own side with smooth 20 m transitions (a calm lane change).
     pub fn lane_v(&self, u: f64) -> f64 {
         let s = &self.spec;
         let lane = s.base_half_width(Side::Left, u) - s.lane_from_left_m;
@@ -396,7 +398,7 @@ impl World {
             let f = if x <= 0.0 {
                 1.0
             } else {
-                1.0 - smooth01(x / 12.0)
+                1.0 - smooth01(x / 20.0)
             };
             v = v.min(lane + (need - lane) * f);
         }
@@ -409,6 +411,11 @@ impl World {
         let center = Centerline::new(spec.heading_deg, spec.u_range.0, spec.pieces.clone());
         // Toe lines, mapped to XY, stored with the sidewalk on their left.
         let mut toes = Vec::new();
+        let crown_cap = spec
+            .half_width
+            .iter()
+            .map(|r| r.1.max(r.2))
+            .fold(0.0, f64::max);
         for side in [Side::Left, Side::Right] {
             let sgn = if side == Side::Left { 1.0 } else { -1.0 };
             for piece in spec.toe_pieces(side) {
@@ -419,15 +426,17 @@ impl World {
                     category: Vec::new(),
                     crown_m: 0.0,
                 };
-                let mut crown: f64 = 0.0;
                 for (ue, hc, hw, cat) in piece {
                     t.pts.push(center.map(ue[0], sgn * ue[1]));
                     t.h_curb.push(hc);
                     t.h_walk.push(hw);
                     t.category.push(cat);
-                    crown = crown.max(spec.base_half_width(side, ue[0]));
                 }
-                t.crown_m = crown;
+                // One crown cap for the whole scene: the road surface, the minimum over
+                // all toes of `cross_slope · min(distance, cap)`, stays continuous where
+                // the nearest toe changes (intersection mouths); on a road narrower than
+                // twice the cap the crown is simply its centre line.
+                t.crown_m = crown_cap;
                 if side == Side::Right {
                     t.pts.reverse();
                     t.h_curb.reverse();
@@ -618,8 +627,8 @@ impl World {
                     continue;
                 }
                 let e = spec.half_width_at(side, u) + rng.gen_range(-0.12..0.04);
-                let stems = rng.gen_range(6..30);
-                let spread = rng.gen_range(0.05..0.25);
+                let stems = rng.gen_range(15..60);
+                let spread = rng.gen_range(0.05..0.3);
                 let tall = rng.gen_range(0.08..0.45);
                 for _ in 0..stems {
                     let p = center.map(
@@ -630,7 +639,7 @@ impl World {
                     prims.push(Prim {
                         shape: Shape::Cyl {
                             c: p,
-                            r: rng.gen_range(0.0015..0.004),
+                            r: rng.gen_range(0.003..0.008),
                             z: [z - 0.02, z + tall * rng.gen_range(0.3..1.0)],
                         },
                         material: Material::Vegetation,
@@ -831,8 +840,8 @@ fn sapporo() -> SceneSpec {
         u_range: (-40.0, 370.0),
         drive: (0.0, 330.0),
         speed_kmh: 35.0,
-        half_width: vec![(0.0, 3.75, 3.75), (215.0, 3.75, 3.75), (230.0, 5.75, 5.75)],
-        curb_h: vec![(0.0, 0.08, 0.08), (215.0, 0.08, 0.08), (230.0, 0.17, 0.17)],
+        half_width: vec![(0.0, 3.75, 3.75), (215.0, 3.75, 3.75), (245.0, 5.75, 5.75)],
+        curb_h: vec![(0.0, 0.08, 0.08), (215.0, 0.08, 0.08), (245.0, 0.17, 0.17)],
         lane_from_left_m: 1.9,
         sidewalk_m: (2.5, 2.5),
         curb_cuts: vec![
@@ -975,6 +984,28 @@ mod tests {
         // The last vertex of the first piece is at the side street's end.
         let last = pieces[0].last().unwrap();
         assert!((last.0[0] - 16.0).abs() < 1e-9 && (last.0[1] - 24.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn weeds_stand_at_the_curb_toe_and_stop_rays() {
+        let w = World::build(tiny(), 1);
+        let stems: Vec<_> = w
+            .objects
+            .prims
+            .iter()
+            .filter(|p| p.material == Material::Vegetation)
+            .collect();
+        assert!(stems.len() > 20, "{}", stems.len());
+        let Shape::Cyl { c, r, z } = stems[0].shape else {
+            panic!("weeds are cylinders")
+        };
+        // Near the left toe: |s| < 0.25 m.
+        let (_, toe) = w.ground.height(c[0], c[1]).unwrap();
+        assert!(toe.unwrap().s.abs() < 0.25);
+        // A level ray at mid-height 1 m away hits the stem (or a stem in front of it).
+        let o = [c[0] - 1.0, c[1], 0.5 * (z[0] + z[1])];
+        let h = w.objects.intersect(o, [1.0, 0.0, 0.0], 0.0, 2.0).unwrap();
+        assert!(h.t <= 1.0 - r + 1e-9 && h.material == Material::Vegetation);
     }
 
     #[test]

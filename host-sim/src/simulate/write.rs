@@ -76,21 +76,27 @@ pub fn write_points(
         header.set_wkt_crs(wkt.into_bytes()).map_err(err)?;
     }
     let mut w = las::Writer::from_path(path, header).map_err(err)?;
-    for r in returns {
-        let p = las::Point {
-            x: r.p[0] + origin[0],
-            y: r.p[1] + origin[1],
-            z: r.p[2] + origin[2],
-            intensity: r.intensity,
-            return_number: 1,
-            number_of_returns: 1,
-            scanner_channel: 0,
-            scan_angle: scan_angle_for_las(r.scan_angle_deg),
-            point_source_id: 1,
-            gps_time: Some(r.t),
-            ..Default::default()
-        };
-        w.write_point(p).map_err(err)?;
+    let wheader = w.header().clone();
+    let builder = || las::PointDataBuilder::new().for_header(&wheader);
+    let to_point = |r: &Return| las::Point {
+        x: r.p[0] + origin[0],
+        y: r.p[1] + origin[1],
+        z: r.p[2] + origin[2],
+        intensity: r.intensity,
+        return_number: 1,
+        number_of_returns: 1,
+        scanner_channel: 0,
+        scan_angle: scan_angle_for_las(r.scan_angle_deg),
+        point_source_id: 1,
+        gps_time: Some(r.t),
+        ..Default::default()
+    };
+    // Slabs of a million points: the LAZ writer compresses a slab's chunks in parallel.
+    for chunk in returns.chunks(1 << 20) {
+        let pd = builder()
+            .build_from_points(chunk.iter().map(to_point))
+            .map_err(err)?;
+        w.write_points(&pd).map_err(err)?;
     }
     w.close().map_err(err)?;
     Ok(())
