@@ -125,6 +125,8 @@ echo "static_ram_bytes: $ram"
 echo "stack_reserved_bytes: $stack"
 echo "ram_total_bytes: $((ram + stack)) (of 131072)"
 echo "stack_high_water_bytes: $(fig stack_high_water_bytes "$WORK/fw-libm.txt")"
+echo "stack_high_water_startup_bytes: $(fig stack_high_water_startup_bytes "$WORK/fw-libm.txt")"
+echo "stack_high_water_run_bytes: $(fig stack_high_water_run_bytes "$WORK/fw-libm.txt")"
 stage() { awk -v s="$1" '$1 == "stage" && $2 == s { n = $3 } END { print n + 0 }' "$2"; }
 for name in libm micromath; do
   c="$WORK/counts-$name.log"

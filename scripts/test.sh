@@ -63,7 +63,7 @@ rm -rf "$FW_WORK"
 step "firmware: a stack overflow, a HardFault and a panic each end the QEMU run with a failure"
 for t in overflow hardfault panic; do
   rc=0
-  QEMU_TIMEOUT=20 firmware/run-qemu.sh firmware/target/libm/thumbv7em-none-eabihf/release/curbtrace-firmware \
+  QEMU_TIMEOUT=20 firmware/run-qemu.sh "${FIRMWARE_TARGET_DIR:-firmware/target}/libm/thumbv7em-none-eabihf/release/curbtrace-firmware" \
     --selftest=$t >/dev/null 2>&1 || rc=$?
   if [ "$rc" -eq 0 ] || [ "$rc" -eq 124 ]; then
     echo "firmware --selftest=$t: exit status $rc (expected a failure, not success or a hang)"; exit 1

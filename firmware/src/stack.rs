@@ -16,6 +16,25 @@ extern "C" {
     static _stack_start: u32;
 }
 
+/// Paints the stack again from its bottom up to just below the current stack pointer, so
+/// that [`high_water_mark_bytes`] then measures the deepest use from here on (the processing
+/// loop) rather than start-up's. Returns the high-water mark before repainting.
+#[inline(never)]
+pub fn repaint() -> usize {
+    let before = high_water_mark_bytes();
+    let (lo, _) = bounds();
+    // 64 bytes of margin for this function's own frame.
+    let top = (cortex_m::register::msp::read() as usize).saturating_sub(64) & !3;
+    let mut addr = lo;
+    while addr < top {
+        // SAFETY: 4-byte aligned, inside the reserved stack region and below the live part
+        // of the stack (under the stack pointer, with margin for this frame).
+        unsafe { core::ptr::write_volatile(addr as *mut u32, cortex_m_rt::STACK_PAINT_VALUE) };
+        addr += 4;
+    }
+    before
+}
+
 /// Bytes reserved for the stack (`_stack_size` in `stack.x`).
 pub fn size_bytes() -> usize {
     let (lo, hi) = bounds();

@@ -55,7 +55,8 @@ pub fn read_lines(stream: &[u8]) -> Result<Vec<LineResult>, ReadError> {
         let packet = Packet::new_checked(&stream[at..]).map_err(|e| bad(format!("{e:?}")))?;
         let len = packet.length();
         let packet = Packet::new_unchecked(&stream[at..at + len]);
-        let (header, points) = OutputHeaderRepr::parse(&packet).map_err(|e| bad(format!("{e:?}")))?;
+        let (header, points) =
+            OutputHeaderRepr::parse(&packet).map_err(|e| bad(format!("{e:?}")))?;
         if header.first == 0 {
             lines.push(LineResult {
                 header: OutputHeaderRepr { first: 0, ..header },
@@ -139,9 +140,10 @@ pub fn compare_approx(a: &[LineResult], b: &[LineResult]) -> ApproxComparison {
     };
     for (x, y) in a.iter().zip(b) {
         let same_candidates = x.header.left == y.header.left && x.header.right == y.header.right;
-        c.candidates += usize::from(x.header.left.is_some()) + usize::from(x.header.right.is_some());
-        c.candidates_differ +=
-            usize::from(x.header.left != y.header.left) + usize::from(x.header.right != y.header.right);
+        c.candidates +=
+            usize::from(x.header.left.is_some()) + usize::from(x.header.right.is_some());
+        c.candidates_differ += usize::from(x.header.left != y.header.left)
+            + usize::from(x.header.right != y.header.right);
         if same_candidates {
             c.scanlines_agree += 1;
         }
@@ -207,9 +209,12 @@ mod tests {
 
     #[test]
     fn reassembles_fragmented_lines() {
-        // 130 points: fragments of 64, 64, 2 (MAX_OUTPUT_POINTS_PER_PACKET = 64 ⇒ 3 packets).
+        // 130 points: fragments of 88 and 42 (MAX_OUTPUT_POINTS_PER_PACKET = 88).
         let pts: Vec<_> = (0..130).map(|i| pt(i, 0, 0)).collect();
-        let stream = encode(&[(header(7, 130, Some(3)), pts.clone()), (header(8, 0, None), vec![])]);
+        let stream = encode(&[
+            (header(7, 130, Some(3)), pts.clone()),
+            (header(8, 0, None), vec![]),
+        ]);
         let lines = read_lines(&stream).expect("reads");
         assert_eq!(lines.len(), 2);
         assert_eq!(lines[0].header.index, 7);
@@ -223,7 +228,10 @@ mod tests {
         let mut stream = encode(&[(header(0, 1, None), vec![pt(1, 0, 0)])]);
         let last = stream.len() - 1;
         stream[last] ^= 1; // breaks the CRC
-        assert!(matches!(read_lines(&stream), Err(ReadError::BadPacket { offset: 0, .. })));
+        assert!(matches!(
+            read_lines(&stream),
+            Err(ReadError::BadPacket { offset: 0, .. })
+        ));
     }
 
     #[test]
@@ -239,19 +247,37 @@ mod tests {
             (header(1, 1, None), vec![pt(2, 11, 0)]),
         ]))
         .unwrap();
-        assert_eq!(compare_exact(&a, &a), ExactComparison { scanlines: 3, differ: 0 });
-        assert_eq!(compare_exact(&a, &b), ExactComparison { scanlines: 3, differ: 2 });
+        assert_eq!(
+            compare_exact(&a, &a),
+            ExactComparison {
+                scanlines: 3,
+                differ: 0
+            }
+        );
+        assert_eq!(
+            compare_exact(&a, &b),
+            ExactComparison {
+                scanlines: 3,
+                differ: 2
+            }
+        );
     }
 
     #[test]
     fn approx_measures_rho_and_candidates() {
         let a = read_lines(&encode(&[
-            (header(0, 2, Some(1)), vec![pt(1, 1000, 0), pt(2, 17_990, 0)]),
+            (
+                header(0, 2, Some(1)),
+                vec![pt(1, 1000, 0), pt(2, 17_990, 0)],
+            ),
             (header(1, 1, Some(0)), vec![pt(3, 0, 1)]),
         ]))
         .unwrap();
         let b = read_lines(&encode(&[
-            (header(0, 2, Some(1)), vec![pt(1, 1016, 0), pt(2, -17_995, 0)]),
+            (
+                header(0, 2, Some(1)),
+                vec![pt(1, 1016, 0), pt(2, -17_995, 0)],
+            ),
             (header(1, 1, None), vec![pt(3, 0, 0)]),
         ]))
         .unwrap();
@@ -261,7 +287,11 @@ mod tests {
         assert_eq!(c.status_differ, 1);
         assert_eq!(c.rho_differ, 2);
         // 179.90° vs −179.95° are 0.15° apart across the wrap; 10.00° vs 10.16° are 0.16°.
-        assert!((c.rho_max_diff_deg - 0.16).abs() < 1e-9, "{}", c.rho_max_diff_deg);
+        assert!(
+            (c.rho_max_diff_deg - 0.16).abs() < 1e-9,
+            "{}",
+            c.rho_max_diff_deg
+        );
         assert_eq!(c.candidates, 2);
         assert_eq!(c.candidates_differ, 1);
         assert_eq!(c.scanlines_agree, 1);

@@ -42,7 +42,11 @@ fn run(args: &[String]) -> Result<(), String> {
         } else {
             // Same lines but different bytes elsewhere cannot happen (streams are lines
             // back to back); say so rather than claim 0 differing lines.
-            println!("identical: no ({} of {} scanlines differ)", c.differ.max(1), c.scanlines);
+            println!(
+                "identical: no ({} of {} scanlines differ)",
+                c.differ.max(1),
+                c.scanlines
+            );
         }
     }
     Ok(())

@@ -47,7 +47,10 @@ fn profile_hit(theta: f64) -> Option<(f64, f64)> {
 struct Noise(u64);
 impl Noise {
     fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         ((self.0 >> 33) as f64 / (1u64 << 31) as f64 - 0.5) * 0.004
     }
 }
@@ -71,7 +74,9 @@ fn stream(lines: usize, pulses: usize) -> Result<Vec<u8>, String> {
             // over the road to the other.
             let theta = std::f64::consts::PI * (1.0 + 2.0 * k as f64 / pulses as f64);
             let t = t0 + line as u64 * line_period_ns + (k as u64 * line_period_ns) / pulses as u64;
-            let Some((x, z)) = profile_hit(theta) else { continue };
+            let Some((x, z)) = profile_hit(theta) else {
+                continue;
+            };
             let r = 1.0 + noise.next() / (x * x + z * z).sqrt();
             pending.push((
                 t,
@@ -108,8 +113,9 @@ fn stream(lines: usize, pulses: usize) -> Result<Vec<u8>, String> {
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let parse = |i: usize, default: usize| -> Result<usize, String> {
-        args.get(i)
-            .map_or(Ok(default), |s| s.parse().map_err(|_| format!("not a count: {s}")))
+        args.get(i).map_or(Ok(default), |s| {
+            s.parse().map_err(|_| format!("not a count: {s}"))
+        })
     };
     let run = || -> Result<(), String> {
         let path = args
