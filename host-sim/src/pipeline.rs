@@ -401,9 +401,14 @@ pub fn extract_file_with(
     progress: &Progress,
 ) -> Result<ExtractResult, ExtractError> {
     let start = Instant::now();
+<<<<<<< HEAD
     let cpu0 = process_cpu_s();
     if opts.method != Method::Bend {
         return Err(ExtractError::Method(opts.method.as_str().into()));
+=======
+    if opts.method == Method::Qiu {
+        return extract_file_qiu(points, traj, cfg, opts, progress, start);
+>>>>>>> qiu
     }
     let mut r = replay_file(points, traj, cfg, opts, progress)?;
     // The scan angle and intensity columns served the replay; free them before the
@@ -447,6 +452,50 @@ pub fn extract_file_with(
     };
     Ok(ExtractResult {
         crs: r.las.crs.clone(),
+        edges,
+        summary,
+    })
+}
+
+/// The `--method qiu` path: the plane-based method works on the unorganised points and
+/// the trajectory alone, so the core is not run (its counters stay zero in the summary).
+fn extract_file_qiu(
+    points: &Path,
+    traj: &Path,
+    cfg: &Config,
+    opts: &ExtractOptions,
+    progress: &Progress,
+    start: Instant,
+) -> Result<ExtractResult, ExtractError> {
+    let (mut columns, las, trajectory, dropped, mut times) =
+        load(points, traj, opts, progress)?;
+    columns.scan_angle_deg = Vec::new();
+    columns.intensity = Vec::new();
+    let t0 = Instant::now();
+    progress.stage("edges", 0);
+    let input = crate::qiu::QiuInput {
+        x: &columns.x,
+        y: &columns.y,
+        z: &columns.z,
+        t: &columns.t,
+        trajectory: &trajectory,
+    };
+    let edges = crate::qiu::extract_edges(&input, &cfg.qiu);
+    times.edges_s = t0.elapsed().as_secs_f64();
+    progress.finish();
+    times.total_s = start.elapsed().as_secs_f64();
+    let summary = Summary {
+        dropped_before_trajectory: dropped.0,
+        dropped_after_trajectory: dropped.1,
+        core: Default::default(),
+        candidates: 0,
+        edges: edges.len() as u64,
+        total_length_m: edges.iter().map(|e| e.length_m()).sum(),
+        times,
+        las: las.clone(),
+    };
+    Ok(ExtractResult {
+        crs: las.crs.clone(),
         edges,
         summary,
     })
