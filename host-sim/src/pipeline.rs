@@ -401,14 +401,9 @@ pub fn extract_file_with(
     progress: &Progress,
 ) -> Result<ExtractResult, ExtractError> {
     let start = Instant::now();
-<<<<<<< HEAD
     let cpu0 = process_cpu_s();
-    if opts.method != Method::Bend {
-        return Err(ExtractError::Method(opts.method.as_str().into()));
-=======
     if opts.method == Method::Qiu {
         return extract_file_qiu(points, traj, cfg, opts, progress, start);
->>>>>>> qiu
     }
     let mut r = replay_file(points, traj, cfg, opts, progress)?;
     // The scan angle and intensity columns served the replay; free them before the
