@@ -462,8 +462,13 @@ fn extract_file_qiu(
     progress: &Progress,
     start: Instant,
 ) -> Result<ExtractResult, ExtractError> {
-    let (mut columns, las, trajectory, dropped, mut times) =
-        load(points, traj, opts, progress)?;
+    let Loaded {
+        mut columns,
+        las,
+        trajectory,
+        dropped,
+        mut times,
+    } = load(points, traj, opts, progress)?;
     columns.scan_angle_deg = Vec::new();
     columns.intensity = Vec::new();
     let t0 = Instant::now();
