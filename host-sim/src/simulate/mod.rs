@@ -236,7 +236,11 @@ pub fn run(
     let reference_path = out_dir.join("reference.geojson");
     write::write_points(&points_path, &sim.returns, origin, spec.epsg)?;
     write::write_trajectory(&trajectory_path, &sim.traj, origin)?;
-    let crs = Crs::Epsg(spec.epsg);
+    // The same CRS text as the LAS file's WKT VLR, so that readers deriving the CRS from
+    // the points and from the reference get identical values.
+    let crs = write::wkt_for(spec.epsg)
+        .map(Crs::Wkt)
+        .unwrap_or(Crs::Epsg(spec.epsg));
     crate::model::write_geojson(&reference_path, &sim.reference, Some(&crs)).map_err(|e| {
         SimError::Write {
             path: reference_path.display().to_string(),
@@ -439,7 +443,7 @@ mod tests {
         assert!((first[6] - 90.0).abs() < 1e-4);
         assert!((first[1] - (sim.traj.samples[0].x + spec.origin[0])).abs() < 1e-4);
         let (refl, crs) = crate::model::read_geojson(&s.reference_path).unwrap();
-        assert_eq!(crs, Some(Crs::Epsg(6691)));
+        assert_eq!(crs, Some(Crs::Wkt(wkt)));
         assert_eq!(refl.len(), sim.reference.len());
     }
 
