@@ -56,6 +56,8 @@ pub struct Config {
     pub replay: ReplayParams,
     /// The bend method's seeding, tracking and post-filters (`[bend]`).
     pub bend: BendParams,
+    /// The plane-based method of Qiu et al. (`[qiu]`).
+    pub qiu: crate::qiu::QiuParams,
 }
 
 impl Config {
@@ -76,6 +78,10 @@ impl Config {
         cfg.kernel_words().map_err(|what| ConfigError::Kernel {
             path: path.to_path_buf(),
             what,
+        })?;
+        cfg.qiu.validate().map_err(|e| ConfigError::Parse {
+            path: path.to_path_buf(),
+            what: format!("[qiu]: {e}"),
         })?;
         Ok(cfg)
     }
