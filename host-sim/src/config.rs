@@ -56,6 +56,8 @@ pub struct Config {
     pub replay: ReplayParams,
     /// The bend method's seeding, tracking and post-filters (`[bend]`).
     pub bend: BendParams,
+    /// The plane-based method (`[qiu]`).
+    pub qiu: crate::qiu::QiuParams,
 }
 
 impl Config {
@@ -120,10 +122,8 @@ pub struct KernelConfig {
     pub smooth_gap_m: f32,
     /// Assembly: pause that ends a line without flags, ns (0 = off).
     pub split_gap_ns: u32,
-    /// Assembly: side change of x′ that splits a line when the jump exceeds this, metres.
-    pub split_jump_m: f32,
-    /// Assembly: side change above this z′ also splits, metres.
-    pub split_above_m: f32,
+    /// Assembly: when the geometric split rule is active (0 = auto, 1 = always, 2 = never).
+    pub split_geometry: u32,
 }
 
 impl Default for KernelConfig {
@@ -145,8 +145,7 @@ impl KernelConfig {
             taubin_mu: p.taubin_mu,
             smooth_gap_m: p.smooth_gap_m,
             split_gap_ns: p.split_gap_ns,
-            split_jump_m: p.split_jump_m,
-            split_above_m: p.split_above_m,
+            split_geometry: p.split_geometry,
         }
     }
 
@@ -162,8 +161,7 @@ impl KernelConfig {
             taubin_mu: self.taubin_mu,
             smooth_gap_m: self.smooth_gap_m,
             split_gap_ns: self.split_gap_ns,
-            split_jump_m: self.split_jump_m,
-            split_above_m: self.split_above_m,
+            split_geometry: self.split_geometry,
         }
     }
 }
