@@ -56,7 +56,7 @@ pub struct Config {
     pub replay: ReplayParams,
     /// The bend method's seeding, tracking and post-filters (`[bend]`).
     pub bend: BendParams,
-    /// The plane-based method of Qiu et al. (`[qiu]`).
+    /// The plane-based method (`[qiu]`).
     pub qiu: crate::qiu::QiuParams,
 }
 
@@ -78,10 +78,6 @@ impl Config {
         cfg.kernel_words().map_err(|what| ConfigError::Kernel {
             path: path.to_path_buf(),
             what,
-        })?;
-        cfg.qiu.validate().map_err(|e| ConfigError::Parse {
-            path: path.to_path_buf(),
-            what: format!("[qiu]: {e}"),
         })?;
         Ok(cfg)
     }
@@ -124,10 +120,9 @@ pub struct KernelConfig {
     pub taubin_mu: f32,
     /// Gap that splits a line into separately smoothed pieces, metres (0 = never).
     pub smooth_gap_m: f32,
-    /// Assembly: a time step between consecutive points longer than this ends a line, ns.
+    /// Assembly: pause that ends a line without flags, ns (0 = off).
     pub split_gap_ns: u32,
-    /// Assembly: when the geometric split (side change away from the nadir) is active:
-    /// 0 = until the first line-start flag, 1 = always, 2 = never.
+    /// Assembly: when the geometric split rule is active (0 = auto, 1 = always, 2 = never).
     pub split_geometry: u32,
 }
 

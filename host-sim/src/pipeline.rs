@@ -277,19 +277,9 @@ pub struct Replayed {
     pub times: StageTimes,
 }
 
-/// The points inside the trajectory and the trajectory, as [`load`] returns them.
-pub struct Loaded {
-    /// The covered points, sorted by time.
-    pub columns: PointColumns,
-    /// Header information.
-    pub las: LasInfo,
-    /// The trajectory.
-    pub trajectory: Trajectory,
-    /// Points dropped before / after the trajectory.
-    pub dropped: (u64, u64),
-    /// Stage times so far.
-    pub times: StageTimes,
-}
+/// What [`load`] returns: the covered points (sorted by time), the header information, the
+/// trajectory, the points dropped before / after it, and the stage times so far.
+pub type Loaded = (PointColumns, LasInfo, Trajectory, (u64, u64), StageTimes);
 
 /// Reads the points and the trajectory and drops (and counts) the points outside it.
 pub fn load(
@@ -325,13 +315,13 @@ pub fn load(
         cols.keep_range(cov.start..cov.end);
     }
     times.trajectory_s += t0.elapsed().as_secs_f64();
-    Ok(Loaded {
-        columns: cols,
+    Ok((
+        cols,
         las,
         trajectory,
-        dropped: (cov.before as u64, cov.after as u64),
+        (cov.before as u64, cov.after as u64),
         times,
-    })
+    ))
 }
 
 /// [`load`], then the replay through the core.
@@ -342,13 +332,7 @@ pub fn replay_file(
     opts: &ExtractOptions,
     progress: &Progress,
 ) -> Result<Replayed, ExtractError> {
-    let Loaded {
-        columns,
-        las,
-        trajectory,
-        dropped,
-        mut times,
-    } = load(points, traj_path, opts, progress)?;
+    let (columns, las, trajectory, dropped, mut times) = load(points, traj_path, opts, progress)?;
     let words = cfg.kernel_words().map_err(|what| ConfigError::Kernel {
         path: PathBuf::from("(config)"),
         what,
@@ -403,7 +387,7 @@ pub fn extract_file_with(
     let start = Instant::now();
     let cpu0 = process_cpu_s();
     if opts.method == Method::Qiu {
-        return extract_file_qiu(points, traj, cfg, opts, progress, start);
+        return extract_qiu(points, traj, cfg, opts, progress, start, cpu0);
     }
     let mut r = replay_file(points, traj, cfg, opts, progress)?;
     // The scan angle and intensity columns served the replay; free them before the
@@ -452,42 +436,43 @@ pub fn extract_file_with(
     })
 }
 
-/// The `--method qiu` path: the plane-based method works on the unorganised points and
-/// the trajectory alone, so the core is not run (its counters stay zero in the summary).
-fn extract_file_qiu(
+/// The second method (Qiu et al.) on the same points: it works on the world points and the
+/// trajectory directly, without the core; the summary's core counters stay zero.
+fn extract_qiu(
     points: &Path,
     traj: &Path,
     cfg: &Config,
     opts: &ExtractOptions,
     progress: &Progress,
     start: Instant,
+    cpu0: f64,
 ) -> Result<ExtractResult, ExtractError> {
-    let Loaded {
-        mut columns,
-        las,
-        trajectory,
-        dropped,
-        mut times,
-    } = load(points, traj, opts, progress)?;
-    columns.scan_angle_deg = Vec::new();
-    columns.intensity = Vec::new();
+    let (cols, las, trajectory, dropped, mut times) = load(points, traj, opts, progress)?;
     let t0 = Instant::now();
+    let c0 = process_cpu_s();
     progress.stage("edges", 0);
     let input = crate::qiu::QiuInput {
-        x: &columns.x,
-        y: &columns.y,
-        z: &columns.z,
-        t: &columns.t,
+        x: &cols.x,
+        y: &cols.y,
+        z: &cols.z,
+        t: &cols.t,
         trajectory: &trajectory,
     };
-    let edges = crate::qiu::extract_edges(&input, &cfg.qiu);
+    let mut edges = crate::qiu::extract_edges(&input, &cfg.qiu);
+    for e in &mut edges {
+        e.method
+            .get_or_insert_with(|| Method::Qiu.as_str().to_string());
+    }
     times.edges_s = t0.elapsed().as_secs_f64();
+    times.cpu.edges_s = process_cpu_s() - c0;
+    times.cpu.peak_rss[2] = peak_rss_bytes();
     progress.finish();
     times.total_s = start.elapsed().as_secs_f64();
+    times.cpu.total_s = process_cpu_s() - cpu0;
     let summary = Summary {
         dropped_before_trajectory: dropped.0,
         dropped_after_trajectory: dropped.1,
-        core: Default::default(),
+        core: ReplayCounters::default(),
         candidates: 0,
         edges: edges.len() as u64,
         total_length_m: edges.iter().map(|e| e.length_m()).sum(),
@@ -495,7 +480,7 @@ fn extract_file_qiu(
         las: las.clone(),
     };
     Ok(ExtractResult {
-        crs: las.crs.clone(),
+        crs: las.crs,
         edges,
         summary,
     })

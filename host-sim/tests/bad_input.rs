@@ -284,8 +284,8 @@ fn points_partly_outside_the_trajectory_are_dropped_and_counted() {
     let before = all.t.iter().filter(|&&t| t < t0).count() as u64;
     let after = all.t.iter().filter(|&&t| t > t1).count() as u64;
     assert!(before > 0 && after > 0);
-    let l = load(&las, &traj, &ExtractOptions::default(), &Progress::hidden()).unwrap();
-    let (cols, info, dropped) = (l.columns, l.las, l.dropped);
+    let (cols, info, _, dropped, _) =
+        load(&las, &traj, &ExtractOptions::default(), &Progress::hidden()).unwrap();
     assert_eq!(dropped, (before, after));
     assert_eq!(cols.len() as u64 + before + after, info.points_selected);
     assert!(cols.t.iter().all(|&t| (t0..=t1).contains(&t)));

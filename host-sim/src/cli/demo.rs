@@ -154,12 +154,8 @@ fn extract(out: &Path, method: MethodArg, cfg: &Config, tty: bool) -> anyhow::Re
                 method: Method::Qiu,
             };
             let t = Instant::now();
-            let pipeline::Loaded {
-                columns: cols,
-                trajectory,
-                times,
-                ..
-            } = pipeline::load(&points, &traj, &opts, &progress)?;
+            let (cols, _las, trajectory, _dropped, times) =
+                pipeline::load(&points, &traj, &opts, &progress)?;
             let params = QiuParams::default();
             let t_edges = Instant::now();
             let input = QiuInput {

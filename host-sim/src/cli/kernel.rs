@@ -1,12 +1,11 @@
 //! `curbtrace kernel STREAM.bin -o RESULTS.bin` — runs the host build of the core (ingest +
-//! kernel, `replay::run::HostPipeline`) over a byte stream and writes its output packets,
+//! kernel, `curbtrace_core::Pipeline`) over a byte stream and writes its output packets,
 //! one line after another (`docs/wire-format.md`), then prints the core's counters.
 
 use anyhow::Context;
-use curbtrace_core::kernel::{PointStatus, ScanlineOutput};
-use curbtrace_core::wire::{
-    EncodeError, OutputHeaderRepr, OutputPointRepr, StreamEncoder, MAX_PACKET_LEN,
-};
+use curbtrace_core::encode_output;
+use curbtrace_core::kernel::ScanlineOutput;
+use curbtrace_core::wire::{StreamEncoder, MAX_PACKET_LEN};
 use curbtrace_host_sim::replay::run::{HostPipeline, LINE_CAPACITY, PIPELINE_STACK};
 use std::io::{Read, Write};
 use std::path::PathBuf;
@@ -19,45 +18,6 @@ pub struct Args {
     /// Output packets.
     #[arg(short, long)]
     pub output: PathBuf,
-}
-
-/// The output packets of one line, appended to `out` (every fragment back to back).
-pub fn encode_line(
-    o: &ScanlineOutput<'_>,
-    enc: &mut StreamEncoder,
-    buf: &mut [u8],
-) -> Result<usize, EncodeError> {
-    let sat = |v: u32| u16::try_from(v).unwrap_or(u16::MAX);
-    let len = o.tag.len();
-    let header = OutputHeaderRepr {
-        index: o.index,
-        start_time_ns: o.start_time_ns,
-        params_hash: o.params_hash,
-        truncated: o.truncated,
-        line_len: u16::try_from(len).map_err(|_| EncodeError::OutOfRange { index: len })?,
-        first: 0,
-        nadir: o.nadir,
-        left: o.left,
-        right: o.right,
-        kept: sat(o.counters.kept),
-        irregular: sat(o.counters.irregular),
-        no_neighbour: sat(o.counters.no_neighbour),
-        peaks: sat(o.counters.peaks),
-    };
-    enc.encode_output_line(
-        &header,
-        |i| {
-            // A point the core rejected as non-finite carries its NaN coordinates; the wire
-            // has no NaN, so it goes out as (0, 0) with its status saying why.
-            let (x, z) = if o.status[i] == PointStatus::NonFinite {
-                (0.0, 0.0)
-            } else {
-                (o.x_m[i], o.z_m[i])
-            };
-            OutputPointRepr::from_f32(o.tag[i], x, z, o.rho_deg[i], o.status[i] as u8, i)
-        },
-        buf,
-    )
 }
 
 /// Runs `curbtrace kernel`.
@@ -90,7 +50,7 @@ fn run_inner(args: Args) -> anyhow::Result<()> {
         }
         lines += 1;
         candidates += u64::from(o.left.is_some()) + u64::from(o.right.is_some());
-        match encode_line(o, &mut enc, &mut buf) {
+        match encode_output(o, &mut enc, &mut buf) {
             Ok(n) => {
                 out_bytes += n as u64;
                 if let Err(e) = out.write_all(&buf[..n]) {
@@ -141,14 +101,15 @@ fn run_inner(args: Args) -> anyhow::Result<()> {
     }
     out.flush()
         .with_context(|| format!("{}: writing the output", args.output.display()))?;
-    let c = pipe.counters();
+    let pc = pipe.counters();
+    let c = pc.ingest;
     eprintln!(
         "{}: {} bytes, {} points packets, {} config packets ({} refused), {} CRC errors, {} sequence gaps, {} garbage bytes",
         args.stream.display(),
         c.bytes_in,
         c.packets_points,
         c.packets_config,
-        pipe.config_rejected(),
+        pc.configs_rejected,
         c.crc_errors,
         c.seq_gaps,
         c.bytes_garbage

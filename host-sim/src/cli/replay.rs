@@ -46,13 +46,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         scanner: args.scanner,
         ..Default::default()
     };
-    let pipeline::Loaded {
-        columns: cols,
-        las,
-        trajectory: traj,
-        dropped,
-        ..
-    } = pipeline::load(&args.points, &args.trajectory, &opts, &progress)?;
+    let (cols, las, traj, dropped, _) =
+        pipeline::load(&args.points, &args.trajectory, &opts, &progress)?;
     let rule = LineRule::choose(&cols.scan_angle_deg, &cols.t, &cfg.replay.line());
     let file = std::fs::File::create(&args.output)
         .with_context(|| format!("{}: creating the stream file", args.output.display()))?;

@@ -1,5 +1,5 @@
 //! The points, projected, encoded into the wire format and run through
-//! `curbtrace_core::pipeline::Pipeline` in-process: the same bytes the firmware would see
+//! `curbtrace_core::Pipeline` in-process: the same bytes the firmware would see
 //! (a config packet first, then point packets with the absolute GPS time in ns as each
 //! packet's base and the column index as each point's tag).
 //!
@@ -21,9 +21,9 @@ use crate::bend::{Candidate, STATUS_NOT_PROCESSED};
 use crate::io::las_in::PointColumns;
 use crate::io::trajectory::Trajectory;
 use crate::model::Side;
-use curbtrace_core::kernel::{Kernel, KernelParams, ScanlineOutput, CONFIG_WORDS};
-use curbtrace_core::scanline::{Ingest, IngestCounters, IngestEvent};
+use curbtrace_core::kernel::{ScanlineOutput, CONFIG_WORDS};
 use curbtrace_core::wire::{PointRecord, StreamEncoder, MAX_PACKET_LEN, MAX_POINTS_PER_PACKET};
+use curbtrace_core::Pipeline;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
@@ -38,72 +38,9 @@ pub const LINE_CAPACITY: usize = 16_384;
 /// Stack size of the threads that run pipelines.
 pub const PIPELINE_STACK: usize = 64 << 20;
 
-/// The core's ingest (ring, parser, assembler) and kernel, composed as
-/// `docs/architecture.md` documents `Pipeline<RING, N>`: bytes in, one
-/// [`ScanlineOutput`] per completed line out; a config packet reconfigures the kernel.
-pub struct HostPipeline {
-    ingest: Ingest<RING, LINE_CAPACITY>,
-    kernel: Kernel<LINE_CAPACITY>,
-    config_rejected: u64,
-}
-
-impl Default for HostPipeline {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl HostPipeline {
-    /// A pipeline with the kernel's defaults until a config packet arrives.
-    pub fn new() -> Self {
-        Self {
-            ingest: Ingest::new(),
-            kernel: Kernel::new(KernelParams::DEFAULT),
-            config_rejected: 0,
-        }
-    }
-
-    /// Offers bytes; returns how many the ring took.
-    pub fn write(&mut self, bytes: &[u8]) -> usize {
-        self.ingest.write(bytes)
-    }
-
-    /// Processes every complete line in the ring.
-    pub fn run(&mut self, mut on_line: impl FnMut(&ScanlineOutput<'_>)) {
-        while let Some(ev) = self.ingest.poll() {
-            match ev {
-                IngestEvent::Config(words) => {
-                    let ok = KernelParams::from_words(&words)
-                        .ok()
-                        .and_then(|p| self.kernel.set_params(p).ok());
-                    if ok.is_none() {
-                        self.config_rejected += 1;
-                    }
-                }
-                IngestEvent::Line(line) => {
-                    let out = self.kernel.process(line);
-                    on_line(&out);
-                }
-            }
-        }
-    }
-
-    /// End of stream: the partial last line is processed too.
-    pub fn finish(&mut self, on_line: impl FnMut(&ScanlineOutput<'_>)) {
-        self.ingest.finish();
-        self.run(on_line);
-    }
-
-    /// The ingest counters.
-    pub fn counters(&self) -> IngestCounters {
-        self.ingest.counters()
-    }
-
-    /// Config packets whose parameters the kernel refused (the old ones stayed).
-    pub fn config_rejected(&self) -> u64 {
-        self.config_rejected
-    }
-}
+/// The host's build of the core: `curbtrace_core::Pipeline` (ingest + kernel), the same
+/// code the firmware's main loop runs.
+pub type HostPipeline = Pipeline<RING, LINE_CAPACITY>;
 
 /// Parameters of the replay (`[replay]` in the config file).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
