@@ -172,7 +172,7 @@ fn devrun() {
             r
         }
     };
-    let t1 = t0.elapsed().as_secs_f64();
+    let _kernel_s = t0.elapsed().as_secs_f64();
     let input = BendInput {
         x: &cols.x,
         y: &cols.y,
@@ -198,7 +198,7 @@ fn devrun() {
             .iter()
             .map(|t| (t.points.len(), postfilter::track_length_m(&input, t)))
             .collect();
-        lens.sort_by(|a, b| b.0.cmp(&a.0));
+        lens.sort_by_key(|l| std::cmp::Reverse(l.0));
         eprintln!(
             "{} tracks, longest (points, m): {:?}",
             lens.len(),
