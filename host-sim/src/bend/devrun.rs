@@ -139,16 +139,40 @@ fn devrun() {
         .unwrap_or_default();
     let t0 = std::time::Instant::now();
     let n = cols.len();
-    let cache = dir.join("standin_kernel.bin");
+    let real = std::env::var("BEND_KERNEL").is_ok_and(|v| v == "real");
+    let cache = dir.join(if real {
+        "real_kernel.bin"
+    } else {
+        "standin_kernel.bin"
+    });
     let (rho, status, scanline, candidates, line) = match std::fs::read(&cache) {
         Ok(b) if b.len() >= 8 * n => read_cache(&b, n),
         _ => {
-            let r = standin_kernel(&cols, &traj);
+            let r = if real {
+                let rep = crate::pipeline::replay_file(
+                    &dir.join("points.laz"),
+                    &dir.join("trajectory.csv"),
+                    &crate::config::Config::default(),
+                    &crate::pipeline::ExtractOptions::default(),
+                    &crate::pipeline::Progress::hidden(),
+                )
+                .unwrap();
+                assert_eq!(
+                    rep.columns.len(),
+                    n,
+                    "points outside the trajectory: not handled here"
+                );
+                let k = rep.kernel;
+                let lines = k.counters.scanlines as u32;
+                (k.rho_deg, k.status, k.scanline, k.candidates, lines)
+            } else {
+                standin_kernel(&cols, &traj)
+            };
             std::fs::write(&cache, write_cache(&r)).unwrap();
             r
         }
     };
-    let t1 = t0.elapsed().as_secs_f64();
+    let _kernel_s = t0.elapsed().as_secs_f64();
     let input = BendInput {
         x: &cols.x,
         y: &cols.y,
@@ -174,12 +198,28 @@ fn devrun() {
             .iter()
             .map(|t| (t.points.len(), postfilter::track_length_m(&input, t)))
             .collect();
-        lens.sort_by(|a, b| b.0.cmp(&a.0));
+        lens.sort_by_key(|l| std::cmp::Reverse(l.0));
         eprintln!(
             "{} tracks, longest (points, m): {:?}",
             lens.len(),
             &lens[..lens.len().min(30)]
         );
+        let (ox, oy) = (traj.samples[0].x, traj.samples[0].y);
+        for t in &tracks {
+            let a = t.points[0] as usize;
+            let z = *t.points.last().unwrap() as usize;
+            eprintln!(
+                "  track {:?} {} pts {:.1} m ({:.1},{:.1})->({:.1},{:.1}) covered {:.2}",
+                t.side,
+                t.points.len(),
+                postfilter::track_length_m(&input, t),
+                input.x[a] - ox,
+                input.y[a] - oy,
+                input.x[z] - ox,
+                input.y[z] - oy,
+                postfilter::covered_share(&input, &grid, t, p)
+            );
+        }
         let tracks = postfilter::remove_short(&input, tracks, p);
         let tracks = postfilter::remove_under_objects(&input, &grid, tracks, p);
         let d = s0.elapsed().as_secs_f64();

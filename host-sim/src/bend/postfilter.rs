@@ -91,10 +91,16 @@ fn segments_cross(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
         && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
 }
 
-/// Filter 3: removes tracks one of whose ends sees the trajectory only across another
-/// track of the same side. All tests are made against the tracks as they came in, so
-/// the result does not depend on the order.
+/// Filter 3: removes tracks that lie behind another track of the same side, seen from
+/// the trajectory. The paper tests the segment from an end of the edge to its nearest
+/// trajectory point for a crossing with another edge; here that test is made at the ends
+/// and every `ROADWAY_SAMPLE_M` along the edge, and the edge goes when more than half of
+/// those segments cross another edge. With the ends alone, two edges that overlap by a few
+/// centimetres where a track stopped and the next one started (at a curb cut, say) would
+/// remove each other's neighbour. All tests are made against the tracks as they came in,
+/// so the result does not depend on their order.
 pub fn remove_outside_roadway(input: &BendInput, route: &Route, tracks: Vec<Track>) -> Vec<Track> {
+    const ROADWAY_SAMPLE_M: f64 = 1.0;
     let polys: Vec<Vec<[f64; 2]>> = tracks
         .iter()
         .map(|t| {
@@ -107,24 +113,68 @@ pub fn remove_outside_roadway(input: &BendInput, route: &Route, tracks: Vec<Trac
                 .collect()
         })
         .collect();
+    let bbox = |poly: &[[f64; 2]]| {
+        poly.iter().fold(
+            [
+                f64::INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::NEG_INFINITY,
+            ],
+            |b, p| {
+                [
+                    b[0].min(p[0]),
+                    b[1].min(p[1]),
+                    b[2].max(p[0]),
+                    b[3].max(p[1]),
+                ]
+            },
+        )
+    };
+    let boxes: Vec<[f64; 4]> = polys.iter().map(|p| bbox(p)).collect();
     let outside: Vec<bool> = (0..tracks.len())
         .map(|k| {
             let poly = &polys[k];
-            let (Some(&first), Some(&last)) = (poly.first(), poly.last()) else {
+            if poly.is_empty() {
                 return false;
-            };
-            [first, last].into_iter().any(|e| {
-                let Some((q, _)) = route.nearest(e[0], e[1]) else {
-                    return false;
-                };
-                (0..tracks.len()).any(|o| {
-                    o != k
-                        && tracks[o].side == tracks[k].side
-                        && polys[o]
-                            .windows(2)
-                            .any(|w| segments_cross(e, q, w[0], w[1]))
+            }
+            // Sample vertices: the ends and one every ROADWAY_SAMPLE_M in between.
+            let mut samples = vec![poly[0]];
+            let mut since = 0.0;
+            for w in poly.windows(2) {
+                since += (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]);
+                if since >= ROADWAY_SAMPLE_M {
+                    samples.push(w[1]);
+                    since = 0.0;
+                }
+            }
+            if poly.len() > 1 {
+                samples.push(poly[poly.len() - 1]);
+            }
+            let crossing = samples
+                .iter()
+                .filter(|&&e| {
+                    let Some((q, _)) = route.nearest(e[0], e[1]) else {
+                        return false;
+                    };
+                    let sb = [
+                        e[0].min(q[0]),
+                        e[1].min(q[1]),
+                        e[0].max(q[0]),
+                        e[1].max(q[1]),
+                    ];
+                    (0..tracks.len()).any(|o| {
+                        let b = boxes[o];
+                        o != k
+                            && tracks[o].side == tracks[k].side
+                            && !(b[0] > sb[2] || b[2] < sb[0] || b[1] > sb[3] || b[3] < sb[1])
+                            && polys[o]
+                                .windows(2)
+                                .any(|w| segments_cross(e, q, w[0], w[1]))
+                    })
                 })
-            })
+                .count();
+            2 * crossing > samples.len()
         })
         .collect();
     tracks

@@ -446,8 +446,18 @@ fn a_parked_car_edge_is_removed_and_the_curb_kept() {
         ..BendParams::default()
     };
     let unfiltered = extract_edges(&sc.input(), &no_filter);
-    let on_car = |e: &EdgeLine| e.points.iter().all(|p| (p[1] - Y0 - 2.5).abs() < 0.1);
-    assert_eq!(unfiltered.iter().filter(|e| on_car(e)).count(), 1);
+    // On the car's foot: most of its points within 0.1 m of the foot line (a track may
+    // start with a hop onto it).
+    let on_car = |e: &EdgeLine| {
+        let n = e
+            .points
+            .iter()
+            .filter(|p| (p[1] - Y0 - 2.5).abs() < 0.1)
+            .count();
+        5 * n >= 4 * e.points.len()
+    };
+    // (It may come out in more than one piece: the precondition is only that it is there.)
+    assert!(unfiltered.iter().any(on_car));
     let edges = extract_edges(&sc.input(), &BendParams::default());
     assert!(!edges.iter().any(on_car), "{edges:#?}");
     // The curb before and after the car is still there, on its toe.
