@@ -1,0 +1,113 @@
+//! End-to-end: simulate a scene, extract road edges through the whole product (LAZ →
+//! projection → wire bytes → core → seeding/tracking/post-filters), score them against the
+//! simulator's ground truth (SPEC §5), and assert the accuracy targets of the accuracy issue
+//! (completeness ≥ 95 %, correctness ≥ 95 %, quality ≥ 90 %, RMS ≤ 20 mm at a 50 mm buffer)
+//! with the one set of default parameters.
+//!
+//! Run in release (`cargo test --release`): the larger scene has millions of points.
+
+use curbtrace_host_sim::config::Config;
+use curbtrace_host_sim::eval::{evaluate, EvalParams, EvalReport};
+use curbtrace_host_sim::model::read_geojson;
+use curbtrace_host_sim::pipeline::extract_file;
+use curbtrace_host_sim::simulate;
+use std::path::Path;
+
+fn simulate_extract_eval(scene: &str, seed: u64, dir: &Path) -> EvalReport {
+    let spec = simulate::scene_by_name(scene).expect("scene exists");
+    let sim = simulate::run(&spec, seed, None, dir, false).expect("simulation runs");
+    assert!(sim.points > 100_000, "{scene}: only {} points", sim.points);
+    let result = extract_file(
+        &dir.join("points.laz"),
+        &dir.join("trajectory.csv"),
+        &Config::default(),
+    )
+    .expect("extraction runs");
+    assert!(!result.edges.is_empty(), "{scene}: no edges");
+    for e in &result.edges {
+        assert_eq!(e.method.as_deref(), Some("bend"));
+        assert!(e.points.len() >= 2);
+    }
+    let (reference, _) = read_geojson(&dir.join("reference.geojson")).expect("reference");
+    evaluate(&reference, &result.edges, &EvalParams::default()).expect("evaluation runs")
+}
+
+fn assert_targets(scene: &str, r: &EvalReport) {
+    let t = &r.total;
+    let table = r.to_markdown();
+    let c = t.completeness_pct.expect("completeness");
+    let p = t.correctness_pct.expect("correctness");
+    let q = t.quality_pct.expect("quality");
+    let rms = t.rms_mm.expect("rms");
+    assert!(c >= 95.0, "{scene}: completeness {c:.1} % < 95 %\n{table}");
+    assert!(p >= 95.0, "{scene}: correctness {p:.1} % < 95 %\n{table}");
+    assert!(q >= 90.0, "{scene}: quality {q:.1} % < 90 %\n{table}");
+    assert!(rms <= 20.0, "{scene}: RMS {rms:.1} mm > 20 mm\n{table}");
+    // Both sides found, each on its own.
+    for s in &r.sides {
+        let q = s.total.quality_pct.unwrap_or(0.0);
+        assert!(
+            q >= 80.0,
+            "{scene}: side {:?} quality {q:.1} %\n{table}",
+            s.side
+        );
+    }
+}
+
+#[test]
+fn tiny_meets_the_accuracy_targets() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = simulate_extract_eval("tiny", 1, dir.path());
+    assert_targets("tiny", &r);
+}
+
+#[test]
+fn curvy_meets_the_accuracy_targets() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = simulate_extract_eval("curvy", 1, dir.path());
+    assert_targets("curvy", &r);
+}
+
+/// The newcomer's command on a small scene: it must write edges, a report and pictures and
+/// print the metrics table.
+#[test]
+fn demo_command_writes_edges_report_and_pictures() {
+    let exe = env!("CARGO_MANIFEST_DIR");
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| Path::new(exe).join("../target"));
+    let profile = if cfg!(debug_assertions) {
+        "debug"
+    } else {
+        "release"
+    };
+    let bin = target.join(profile).join("curbtrace");
+    assert!(
+        bin.exists(),
+        "{} not built (cargo test --workspace builds it)",
+        bin.display()
+    );
+    let out = tempfile::tempdir().unwrap();
+    let o = std::process::Command::new(&bin)
+        .args(["demo", "--scene", "tiny", "--out"])
+        .arg(out.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "demo failed: {}\n{stdout}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(stdout.contains("Quality"), "no metrics table:\n{stdout}");
+    for f in ["report.md", "edges.geojson"] {
+        let p = out.path().join(f);
+        assert!(p.exists(), "{} missing", p.display());
+    }
+    let pngs = std::fs::read_dir(out.path())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.path().extension().is_some_and(|x| x == "png"))
+        .count();
+    assert!(pngs >= 2, "only {pngs} pictures");
+}
