@@ -42,7 +42,11 @@ fuzz_target!(|data: &[u8]| {
             assert!(cols.len() as u64 <= info.points_in_file);
             // Sorted by time (the reader's contract).
             let t = &cols.t;
-            assert!(t.windows(2).all(|w| !(w[1] < w[0])), "not sorted by time");
+            assert!(
+                t.windows(2)
+                    .all(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Less)),
+                "not sorted by time"
+            );
         }
     } else {
         let text = String::from_utf8_lossy(bytes);

@@ -97,7 +97,15 @@ struct Builder {
     tag: u32,
 }
 
+/// Stream size cap (about 6500 points, 13 lines of capacity `N`): long enough for
+/// truncated lines, short enough for a few hundred executions per second.
+const MAX_STREAM: usize = 128 << 10;
+
 impl Builder {
+    fn full(&self) -> bool {
+        self.stream.len() + self.pending.len() * 20 > MAX_STREAM
+    }
+
     fn flush(&mut self) {
         if self.pending.is_empty() {
             return;
@@ -112,7 +120,7 @@ impl Builder {
     }
 
     fn point(&mut self, x: f32, z: f32) {
-        if self.stream.len() > 1 << 20 || !x.is_finite() || !z.is_finite() {
+        if self.full() || !x.is_finite() || !z.is_finite() {
             return; // keep executions fast; the wire carries finite coordinates only
         }
         // dt_ns is u32 relative to the packet's base time.
@@ -158,11 +166,17 @@ fn build(input: &Input) -> Vec<u8> {
         match *run {
             Run::Dup { x, z, n } => {
                 for _ in 0..n.min(4096) {
+                    if b.full() {
+                        break;
+                    }
                     b.point(x.0, z.0);
                 }
             }
             Run::Ramp { x, z, dx, dz, n } => {
                 for i in 0..n.min(4096) {
+                    if b.full() {
+                        break;
+                    }
                     let k = f32::from(i);
                     b.point(x.0 + k * dx.0, z.0 + k * dz.0);
                 }
@@ -176,7 +190,7 @@ fn build(input: &Input) -> Vec<u8> {
                 let sp = f32::from(spacing_mm.max(1)) * 1e-3;
                 let step = f32::from(step_mm % 500) * 1e-3;
                 let mut x = hw;
-                while x > -hw {
+                while x > -hw && !b.full() {
                     let z = if x.abs() > hw * 0.6 {
                         -2.0 + step
                     } else {
