@@ -71,32 +71,7 @@ for t in overflow hardfault panic; do
 done
 
 # --- fuzzing (fuzz/, docs/robustness.md) ------------------------------------------------
-step "fuzz: cargo fmt --check and clippy on the fuzz crate (-D warnings)"
-command -v cargo-fuzz >/dev/null 2>&1 || cargo install cargo-fuzz --locked
-if rustup run nightly rustc --version >/dev/null 2>&1; then
-  FUZZ_TC=(+nightly); FUZZ_SAN=()
-else
-  # No nightly: stable with RUSTC_BOOTSTRAP, without a sanitizer (-s none).
-  export RUSTC_BOOTSTRAP=1; FUZZ_TC=(); FUZZ_SAN=(-s none)
-fi
-FUZZ_TARGET="${CARGO_TARGET_DIR:-$ROOT/target}/fuzz"
-cargo fmt --check --manifest-path fuzz/Cargo.toml
-cargo "${FUZZ_TC[@]}" clippy --manifest-path fuzz/Cargo.toml --target-dir "$FUZZ_TARGET-clippy" \
-  --all-targets --features host -- -D warnings
-for t in wire_parse ingest kernel_points host_inputs; do
-  step "fuzz: $t for 20 s from fuzz/corpus/$t (any crash fails)"
-  work=$(mktemp -d)
-  # wire_parse runs without AddressSanitizer (8x faster; the core forbids unsafe code,
-  # docs/robustness.md), in its own target dir so the ASan builds stay cached.
-  san=("${FUZZ_SAN[@]}"); dir="$FUZZ_TARGET"
-  if [ "$t" = wire_parse ]; then san=(-s none); dir="$FUZZ_TARGET-none"; fi
-  feat=(); if [ "$t" = host_inputs ]; then feat=(--features host); fi
-  (cd fuzz && cargo "${FUZZ_TC[@]}" fuzz run "${san[@]}" "${feat[@]}" --target-dir "$dir" \
-    "$t" "$work" "corpus/$t" -- -max_total_time=20 -max_len=65536 -rss_limit_mb=2048 \
-    -malloc_limit_mb=512 -artifact_prefix="$work/")
-  rm -rf "$work"
-done
-unset RUSTC_BOOTSTRAP
+./scripts/fuzz-smoke.sh
 
 echo
 echo "all checks passed"

@@ -127,8 +127,14 @@ impl Threshold {
     }
 }
 
+/// Largest |x′| or |z′| the kernel accepts, metres; farther points get
+/// [`PointStatus::NonFinite`]. Beyond any lidar's range (a VQ-250 reaches about 500 m) and
+/// inside what an output packet can carry (±2147 m).
+pub const MAX_COORD_M: f32 = 2000.0;
+
 /// §2.4 on the raw line: marks each point [`PointStatus::Irregular`] when |ρ| exceeds the
-/// threshold, [`PointStatus::NonFinite`] when a coordinate is NaN or infinite, and
+/// threshold, [`PointStatus::NonFinite`] when a coordinate is NaN, infinite or beyond
+/// ±[`MAX_COORD_M`], and
 /// provisionally [`PointStatus::Kept`] otherwise (also when it has no neighbour on one side:
 /// no ρ, nothing to judge). A point with no neighbour on *either* side is judged with its
 /// two adjacent points as s and t: a lone spike taller than d_b would otherwise survive
@@ -152,7 +158,13 @@ pub(crate) fn mark_irregular(
         let s = i - usize::from(s_off[i]);
         let t = i + usize::from(t_off[i]);
         let (xi, zi) = (x[i], z[i]);
-        if !(xi.is_finite() && zi.is_finite()) {
+        // Out of range counts as non-finite: the wire carries any finite f32, but squares of
+        // coordinates near f32::MAX overflow in the bend angle and in smoothing (found by the
+        // `kernel_points` fuzz target), and output packets hold |x′|, |z′| < 2147 m.
+        // `contains` is false for NaN and ±inf.
+        if !((-MAX_COORD_M..=MAX_COORD_M).contains(&xi)
+            && (-MAX_COORD_M..=MAX_COORD_M).contains(&zi))
+        {
             status[i] = PointStatus::NonFinite;
             non_finite += 1;
             continue;

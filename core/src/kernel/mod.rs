@@ -51,7 +51,8 @@ pub enum PointStatus {
     Irregular = 1,
     /// Kept, but has no neighbour within d_b on one side, so no ρ (ρ reported as 0).
     NoNeighbour = 2,
-    /// Removed before anything else: x′ or z′ is NaN or infinite.
+    /// Removed before anything else: x′ or z′ is NaN, infinite or beyond ±2000 m
+    /// (`MAX_COORD_M`).
     NonFinite = 3,
 }
 

@@ -695,3 +695,29 @@ fn stage_timings() {
     });
     std::println!("whole process: {r:.1?} ns/pt");
 }
+
+/// Regression (fuzz target `kernel_points`, fuzz/regressions/kernel_points/): finite but
+/// huge coordinates overflowed in smoothing and gave non-finite smoothed points.
+#[test]
+fn huge_finite_coordinates_are_set_aside_and_every_output_stays_finite() {
+    let mut pts = ideal_curb(false, false);
+    pts[10].0 = f32::MAX;
+    pts[11].1 = -3.0e38;
+    pts[12].0 = 2000.5;
+    let mut line = line_from(&pts);
+    let mut k = Kernel::<N>::new(KernelParams::DEFAULT);
+    let out = k.process(&mut line);
+    check_accounting(&out);
+    for i in [10usize, 11, 12] {
+        assert_eq!(out.status[i], PointStatus::NonFinite, "point {i}");
+    }
+    for i in 0..out.tag.len() {
+        if out.status[i] != PointStatus::NonFinite {
+            assert!(
+                out.x_m[i].is_finite() && out.z_m[i].is_finite(),
+                "point {i}"
+            );
+            assert!(out.rho_deg[i].is_finite(), "rho at {i}");
+        }
+    }
+}

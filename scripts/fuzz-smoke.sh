@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Fuzz smoke runs (part of scripts/test.sh): lint fuzz/, then each target for 20 s from its
+# committed corpus; any crash fails. Installs cargo-fuzz when missing.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$(pwd)
+step() { printf '\n==> %s\n' "$*"; }
+step "fuzz: cargo fmt --check and clippy on the fuzz crate (-D warnings)"
+command -v cargo-fuzz >/dev/null 2>&1 || cargo install cargo-fuzz --locked
+if rustup run nightly rustc --version >/dev/null 2>&1; then
+  FUZZ_TC=(+nightly); FUZZ_SAN=()
+else
+  # No nightly: stable with RUSTC_BOOTSTRAP, without a sanitizer (-s none).
+  export RUSTC_BOOTSTRAP=1; FUZZ_TC=(); FUZZ_SAN=(-s none)
+fi
+FUZZ_TARGET="${CARGO_TARGET_DIR:-$ROOT/target}/fuzz"
+cargo fmt --check --manifest-path fuzz/Cargo.toml
+cargo "${FUZZ_TC[@]}" clippy --manifest-path fuzz/Cargo.toml --target-dir "$FUZZ_TARGET-clippy" \
+  --all-targets --features host -- -D warnings
+for t in wire_parse ingest kernel_points host_inputs; do
+  step "fuzz: $t for 20 s from fuzz/corpus/$t (any crash fails)"
+  work=$(mktemp -d)
+  # The smoke runs go without AddressSanitizer (-s none): the core forbids unsafe code,
+  # the build is much shorter and the targets run ~8x faster (docs/robustness.md); the
+  # long runs in docs/robustness.md used ASan.
+  san=(-s none); dir="$FUZZ_TARGET"
+  feat=(); if [ "$t" = host_inputs ]; then feat=(--features host); fi
+  (cd fuzz && cargo "${FUZZ_TC[@]}" fuzz run "${san[@]}" "${feat[@]}" --target-dir "$dir" \
+    "$t" "$work" "corpus/$t" -- -max_total_time=20 -max_len=65536 -rss_limit_mb=2048 \
+    -malloc_limit_mb=512 -artifact_prefix="$work/")
+  rm -rf "$work"
+done
+step "fuzz: every input that once crashed (fuzz/regressions/) runs clean"
+for f in fuzz/regressions/*/*; do
+  [ -f "$f" ] || continue
+  t=$(basename "$(dirname "$f")")
+  feat=(); if [ "$t" = host_inputs ]; then feat=(--features host); fi
+  (cd fuzz && cargo "${FUZZ_TC[@]}" fuzz run -s none "${feat[@]}" --target-dir "$FUZZ_TARGET" \
+    "$t" "../$f" -- -runs=1)
+done
+unset RUSTC_BOOTSTRAP
