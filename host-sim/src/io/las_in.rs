@@ -310,6 +310,58 @@ struct RawHead {
     count: u64,
 }
 
+/// LAS 1.4 extended VLRs: the `las` crate sizes each EVLR's buffer by its 64-bit length
+/// field before reading it, so a corrupt length would allocate up to 2⁶⁴ bytes (found by the
+/// `host_inputs` fuzz target). Walk the EVLR headers first and check that every record lies
+/// inside the file.
+fn check_evlrs(path: &Path, file: &mut File, head: &[u8], file_size: u64) -> Result<(), LasError> {
+    use std::io::{Seek, SeekFrom};
+    const EVLR_HEADER_LEN: u64 = 60;
+    if head.len() < 247 || (head[24], head[25]) < (1, 4) {
+        return Ok(());
+    }
+    let mut start = [0u8; 8];
+    start.copy_from_slice(&head[235..243]);
+    let mut pos = u64::from_le_bytes(start);
+    let count = u32::from_le_bytes([head[243], head[244], head[245], head[246]]);
+    let bad = |what: String| LasError::Truncated {
+        path: path.to_path_buf(),
+        what,
+    };
+    for i in 0..count {
+        if pos
+            .checked_add(EVLR_HEADER_LEN)
+            .is_none_or(|end| end > file_size)
+        {
+            return Err(bad(format!(
+                "extended VLR {i} of {count} would start at byte {pos}, past the end of the {file_size}-byte file"
+            )));
+        }
+        let mut len = [0u8; 8];
+        file.seek(SeekFrom::Start(pos + 52))
+            .and_then(|_| file.read_exact(&mut len))
+            .map_err(|source| LasError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        let len = u64::from_le_bytes(len);
+        match (pos + EVLR_HEADER_LEN).checked_add(len) {
+            Some(end) if end <= file_size => pos = end,
+            _ => {
+                return Err(bad(format!(
+                    "extended VLR {i} at byte {pos} claims {len} bytes, more than the {file_size}-byte file holds"
+                )))
+            }
+        }
+    }
+    file.seek(SeekFrom::Start(0))
+        .map_err(|source| LasError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    Ok(())
+}
+
 fn parse_raw_head(path: &Path, bytes: &[u8], file_size: u64) -> Result<RawHead, LasError> {
     let path = path.to_path_buf();
     if file_size == 0 {
@@ -409,6 +461,7 @@ pub fn read_points(
         .read_to_end(&mut head_bytes)
         .map_err(io)?;
     let head = parse_raw_head(path, &head_bytes, file_size)?;
+    check_evlrs(path, &mut file, &head_bytes, file_size)?;
     if !format_has_gps_time(head.format) {
         return Err(LasError::NoGpsTime {
             path: path.to_path_buf(),
@@ -799,6 +852,36 @@ pub(crate) mod tests {
 
     fn read(path: &Path, scanner: Option<u16>) -> Result<(PointColumns, LasInfo), LasError> {
         read_points(path, &ReadOptions { scanner }, &mut |_, _| {})
+    }
+
+    /// Regression (fuzz target `host_inputs`): an EVLR whose 64-bit length exceeds the file
+    /// made the `las` crate try to allocate that many bytes.
+    #[test]
+    fn an_extended_vlr_longer_than_the_file_is_an_error_before_any_allocation() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("evlr.las");
+        let pts: Vec<Point> = (0..10)
+            .map(|i| pt(500_000.0 + i as f64, 4_000_000.0, 0.0, i as f64))
+            .collect();
+        write_las(&path, 6, &pts, None);
+        let mut bytes = std::fs::read(&path).unwrap();
+        let end = bytes.len() as u64;
+        // One EVLR right after the points, claiming 2^62 bytes.
+        bytes[235..243].copy_from_slice(&end.to_le_bytes());
+        bytes[243..247].copy_from_slice(&1u32.to_le_bytes());
+        let mut evlr = vec![0u8; 60];
+        evlr[52..60].copy_from_slice(&(1u64 << 62).to_le_bytes());
+        bytes.extend_from_slice(&evlr);
+        std::fs::write(&path, &bytes).unwrap();
+        let err = read(&path, None).unwrap_err().to_string();
+        assert!(
+            err.contains("evlr.las") && err.contains("extended VLR"),
+            "{err}"
+        );
+        // The same file with an honest EVLR length reads.
+        bytes[end as usize + 52..end as usize + 60].copy_from_slice(&0u64.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        assert_eq!(read(&path, None).unwrap().0.t.len(), 10);
     }
 
     #[test]
