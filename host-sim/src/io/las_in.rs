@@ -186,7 +186,7 @@ pub struct LasInfo {
     /// The file's CRS: EPSG from the GeoTIFF keys, or the WKT VLR; `None` when absent.
     pub crs: Option<Crs>,
     /// Whether the points had to be reordered by time.
-    pub was_sorted: bool,
+    pub was_reordered: bool,
     /// Whether the scan angle column carries information (not all one value).
     pub has_scan_angle: bool,
 }
@@ -362,6 +362,81 @@ fn check_evlrs(path: &Path, file: &mut File, head: &[u8], file_size: u64) -> Res
     Ok(())
 }
 
+/// LAZ: the `laszip encoded` VLR's item list, checked before the `laz` crate uses it: the
+/// items' sizes must add up to the header's point record length (the crate divides by that
+/// sum, and a zero sum panicked in its parallel decompressor — fuzz target `host_inputs`),
+/// and a fixed chunk of points must not ask for more than 1 GiB of decompression buffer.
+fn check_laszip_vlr(
+    path: &Path,
+    file: &mut File,
+    head_bytes: &[u8],
+    head: &RawHead,
+) -> Result<(), LasError> {
+    use std::io::{Seek, SeekFrom};
+    const VLR_HEADER_LEN: u64 = 54;
+    if !head.compressed || head_bytes.len() < 104 {
+        return Ok(());
+    }
+    let io = |source| LasError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let bad = |what: String| LasError::Truncated {
+        path: path.to_path_buf(),
+        what,
+    };
+    let vlrs = u32::from_le_bytes([
+        head_bytes[100],
+        head_bytes[101],
+        head_bytes[102],
+        head_bytes[103],
+    ]);
+    let end = u64::from(head.offset_to_point_data);
+    let mut pos = u64::from(head.header_size);
+    for _ in 0..vlrs {
+        if pos + VLR_HEADER_LEN > end {
+            break;
+        }
+        let mut h = [0u8; VLR_HEADER_LEN as usize];
+        file.seek(SeekFrom::Start(pos))
+            .and_then(|_| file.read_exact(&mut h))
+            .map_err(io)?;
+        let record_id = u16::from_le_bytes([h[18], h[19]]);
+        let len = u64::from(u16::from_le_bytes([h[20], h[21]]));
+        if h[2..18].starts_with(b"laszip encoded") && record_id == 22204 {
+            let mut body = vec![0u8; len as usize]; // at most 65 535 bytes
+            if pos + VLR_HEADER_LEN + len > end
+                || file.read_exact(&mut body).is_err()
+                || body.len() < 34
+            {
+                break; // the `las` crate reports the short record itself
+            }
+            let chunk_size = u32::from_le_bytes([body[12], body[13], body[14], body[15]]);
+            let items = usize::from(u16::from_le_bytes([body[32], body[33]]));
+            let sizes: u32 = body[34..]
+                .chunks_exact(6)
+                .take(items)
+                .map(|it| u32::from(u16::from_le_bytes([it[2], it[3]])))
+                .sum();
+            if sizes == 0 || sizes != u32::from(head.record_len) {
+                return Err(bad(format!(
+                    "the LAZ items describe {sizes}-byte points but the header says {}-byte records",
+                    head.record_len
+                )));
+            }
+            if chunk_size != u32::MAX && u64::from(chunk_size) * u64::from(sizes) > 1 << 30 {
+                return Err(bad(format!(
+                    "the LAZ chunk size of {chunk_size} points of {sizes} bytes needs more than 1 GiB per chunk"
+                )));
+            }
+            break;
+        }
+        pos += VLR_HEADER_LEN + len;
+    }
+    file.seek(SeekFrom::Start(0)).map_err(io)?;
+    Ok(())
+}
+
 /// LAZ: the chunk table's entry count, checked against the compressed bytes before the
 /// `laz` crate reserves a `Vec` of that many 16-byte entries (fuzz target `host_inputs`
 /// found a 2^32-entry claim: a 60 GB allocation). Every chunk takes at least one byte
@@ -524,6 +599,7 @@ pub fn read_points(
         .map_err(io)?;
     let head = parse_raw_head(path, &head_bytes, file_size)?;
     check_evlrs(path, &mut file, &head_bytes, file_size)?;
+    check_laszip_vlr(path, &mut file, &head_bytes, &head)?;
     check_laz_chunk_table(path, &mut file, &head, file_size)?;
     if !format_has_gps_time(head.format) {
         return Err(LasError::NoGpsTime {
@@ -736,7 +812,7 @@ pub fn read_points(
         .scan_angle_deg
         .first()
         .is_some_and(|&a| cols.scan_angle_deg.iter().any(|&b| b != a));
-    let was_sorted = !cols.sort_by_time();
+    let was_reordered = cols.sort_by_time();
     let info = LasInfo {
         path: path.to_path_buf(),
         version: head.version,
@@ -746,7 +822,7 @@ pub fn read_points(
         points_selected: cols.len() as u64,
         selection,
         crs,
-        was_sorted,
+        was_reordered,
         has_scan_angle,
     };
     Ok((cols, info))
@@ -917,6 +993,43 @@ pub(crate) mod tests {
         read_points(path, &ReadOptions { scanner }, &mut |_, _| {})
     }
 
+    /// Regression (fuzz target `host_inputs`, session 2): LAZ items whose sizes add up to 0
+    /// made the `laz` crate's parallel decompressor divide by zero.
+    #[test]
+    fn laz_items_that_do_not_describe_the_point_record_are_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("items.laz");
+        let pts: Vec<Point> = (0..10)
+            .map(|i| pt(500_000.0 + i as f64, 4_000_000.0, 0.0, i as f64))
+            .collect();
+        write_las(&path, 6, &pts, None);
+        let good = std::fs::read(&path).unwrap();
+        let vlr = good
+            .windows(14)
+            .position(|w| w == b"laszip encoded")
+            .expect("a laszip VLR")
+            - 2;
+        let body = vlr + 54;
+        let items = usize::from(u16::from_le_bytes([good[body + 32], good[body + 33]]));
+        assert!(items >= 1);
+        for size in [0u16, 29] {
+            let mut bytes = good.clone();
+            for k in 0..items {
+                let at = body + 34 + 6 * k + 2;
+                let v = if k == 0 { size } else { 0 };
+                bytes[at..at + 2].copy_from_slice(&v.to_le_bytes());
+            }
+            std::fs::write(&path, &bytes).unwrap();
+            let err = read(&path, None).unwrap_err().to_string();
+            assert!(
+                err.contains("items.laz") && err.contains(&format!("describe {size}-byte points")),
+                "{err}"
+            );
+        }
+        std::fs::write(&path, &good).unwrap();
+        assert_eq!(read(&path, None).unwrap().0.t.len(), 10);
+    }
+
     /// Regression (fuzz target `host_inputs`, session 2): a LAZ chunk table claiming 2^32
     /// chunks made the `laz` crate reserve 60 GB before decoding a single entry.
     #[test]
@@ -996,7 +1109,7 @@ pub(crate) mod tests {
             assert_eq!(c.z, vec![6.0, 3.0, 9.0]);
             assert_eq!(c.intensity, vec![7, 7, 7]);
             assert_eq!(info.crs, Some(Crs::Epsg(6677)));
-            assert!(!info.was_sorted);
+            assert!(info.was_reordered, "the file's times are 10.5, 10.25, 10.5");
             assert_eq!(info.point_format, 6);
             assert_eq!(info.compressed, name.ends_with("laz"));
             assert_eq!(info.points_selected, 3);
