@@ -1,0 +1,707 @@
+//! Real captures: what the product does with the real lidar samples in
+//! `shared/realdata/` (see `docs/real-data.md`).
+//!
+//! The data sit outside the repository (their licences differ from the product's). They are
+//! looked for in `$CURBTRACE_REALDATA`, else in `shared/realdata/` beside the workspace root
+//! or one of its parents (`<workspace>/../shared/realdata` on the lead's checkout). When
+//! they are absent every test prints `skipped: … not found` to stderr and passes, so CI
+//! machines without them stay green.
+//!
+//! 1. The Amsterdam tiles (CycloMedia MLS, LAS 1.2 format 3, LAZ) read through
+//!    `io::las_in::read_points`: counts, times, extent, CRS, and the same coordinates as
+//!    the `las` crate's own decoding.
+//! 2. `curbtrace extract` with a trajectory that does not cover a real tile: a one-line
+//!    error naming both files.
+//! 3. The core kernel (Honma et al. steps b–d, exactly as shipped, default parameters) on
+//!    *virtual scanlines* cut from the labelled tiles across the road|sidewalk boundary:
+//!    how often its left seed candidate lies within 0.1 m / 0.2 m of the label boundary.
+
+use curbtrace_core::kernel::{Kernel, KernelParams, PointStatus};
+use curbtrace_core::scanline::Line;
+use curbtrace_host_sim::io::las_in::{read_points, ReadOptions};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+// ---------------------------------------------------------------------------------------
+// Where the data are
+// ---------------------------------------------------------------------------------------
+
+/// The `realdata` folder, if present: `$CURBTRACE_REALDATA`, else `shared/realdata` in the
+/// parent of the workspace root or one of its next two ancestors (worktrees may sit one or
+/// two levels deeper than the main checkout).
+fn realdata_dir() -> Option<PathBuf> {
+    if let Some(d) = std::env::var_os("CURBTRACE_REALDATA") {
+        let d = PathBuf::from(d);
+        return d.is_dir().then_some(d);
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent()?;
+    root.ancestors()
+        .skip(1)
+        .take(3)
+        .map(|a| a.join("shared/realdata"))
+        .find(|d| d.is_dir())
+}
+
+/// The sub-folder `sub` of the data, or `None` after printing why the test is skipped.
+fn data(sub: &str, test: &str) -> Option<PathBuf> {
+    let found = realdata_dir().map(|d| d.join(sub)).filter(|d| d.is_dir());
+    if found.is_none() {
+        eprintln!(
+            "skipped: {test}: {sub} not found (looked in $CURBTRACE_REALDATA and in \
+             shared/realdata beside {}/.. and its parents)",
+            env!("CARGO_MANIFEST_DIR")
+        );
+    }
+    found
+}
+
+const AMS: &str = "amsterdam_cyclomedia";
+
+/// The Amsterdam tiles: name, points (from `shared/realdata/README.md`), tile column and row
+/// (the tile covers [50·col, 50·col + 50] × [50·row, 50·row + 50] in RD New metres).
+const TILES: [(&str, u64, i64, i64); 4] = [
+    ("2293_9698", 293_074, 2293, 9698),
+    ("2294_9700", 44_566, 2294, 9700),
+    ("2292_9700", 33_984, 2292, 9700),
+    ("2294_9701", 26_378, 2294, 9701),
+];
+
+/// The tiles that have a labelled `output_road_ground_labelled_*` file.
+const LABELLED: [&str; 2] = ["2293_9698", "2294_9700"];
+
+fn labelled_path(dir: &Path, tile: &str) -> PathBuf {
+    dir.join(format!("output_road_ground_labelled_{tile}.laz"))
+}
+
+// ---------------------------------------------------------------------------------------
+// 1. Reading
+// ---------------------------------------------------------------------------------------
+
+/// Every point of a file in file order through the `las` crate (x, y, z, t, the first
+/// extra byte).
+struct Raw {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+    t: Vec<f64>,
+    extra0: Vec<u8>,
+    header_count: u64,
+    extra_bytes: u16,
+}
+
+fn read_raw(path: &Path) -> Raw {
+    let mut r = las::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let header_count = r.header().number_of_points();
+    let extra_bytes = r.header().point_format().extra_bytes;
+    let pd = r.read_all().unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut raw = Raw {
+        x: pd.x().collect(),
+        y: pd.y().collect(),
+        z: pd.z().collect(),
+        t: pd.gps_time().expect("format 3 has GPS time").collect(),
+        extra0: Vec::new(),
+        header_count,
+        extra_bytes,
+    };
+    if extra_bytes > 0 {
+        // The extra bytes are the last `extra_bytes` of each record.
+        let len = pd.record_len();
+        let off = len - usize::from(extra_bytes);
+        raw.extra0 = pd.raw_bytes().chunks_exact(len).map(|r| r[off]).collect();
+    }
+    raw
+}
+
+#[test]
+fn amsterdam_tiles_read_through_las_in() {
+    let Some(dir) = data(AMS, "amsterdam_tiles_read_through_las_in") else {
+        return;
+    };
+    let mut files: Vec<(PathBuf, u64, i64, i64)> = TILES
+        .iter()
+        .map(|&(t, n, c, r)| (dir.join(format!("input_{t}.laz")), n, c, r))
+        .collect();
+    for t in LABELLED {
+        let &(_, n, c, r) = TILES.iter().find(|x| x.0 == t).unwrap();
+        files.push((labelled_path(&dir, t), n, c, r));
+    }
+    for (path, n, col, row) in files {
+        let (cols, info) = read_points(&path, &ReadOptions::default(), &mut |_, _| {})
+            .unwrap_or_else(|e| panic!("read_points failed on a real tile: {e}"));
+        let name = path.display();
+        assert_eq!(cols.len() as u64, n, "{name}: README's point count");
+        assert_eq!(info.points_in_file, n, "{name}");
+        assert_eq!(info.points_selected, n, "{name}");
+        assert_eq!((info.version, info.point_format), ((1, 2), 3), "{name}");
+        assert!(info.compressed, "{name}");
+        // The files carry no GeoTIFF keys and no WKT (checked with the las crate: the only
+        // VLRs are the extra-bytes description and LASzip's): RD New + NAP is known only
+        // from the data's documentation, so the reader must report no CRS rather than guess.
+        assert_eq!(info.crs, None, "{name}: the file states no CRS");
+        // The scan angle is 0 everywhere in these files: line starts cannot come from it.
+        assert!(!info.has_scan_angle, "{name}");
+        assert!(cols.t.windows(2).all(|w| w[0] <= w[1]), "{name}: time order");
+        // Several passes per tile: the times span about a day (2.8e8 s adjusted GPS time).
+        let (t0, t1) = cols.time_range().unwrap();
+        assert!(t0 > 2.8e8 && t1 < 2.9e8, "{name}: times {t0}..{t1}");
+        // Inside the 50 m × 50 m tile, and spanning most of it.
+        let (x0, y0) = (50.0 * col as f64, 50.0 * row as f64);
+        let ext = |v: &[f64]| {
+            v.iter()
+                .fold((f64::MAX, f64::MIN), |(a, b), &c| (a.min(c), b.max(c)))
+        };
+        let ((xmin, xmax), (ymin, ymax), (zmin, zmax)) = (ext(&cols.x), ext(&cols.y), ext(&cols.z));
+        assert!(
+            xmin >= x0 && xmax <= x0 + 50.0 && ymin >= y0 && ymax <= y0 + 50.0,
+            "{name}: [{xmin}, {xmax}] × [{ymin}, {ymax}] outside the tile at ({x0}, {y0})"
+        );
+        assert!(
+            xmax - xmin > 35.0 && ymax - ymin > 35.0,
+            "{name}: extent {} × {} m",
+            xmax - xmin,
+            ymax - ymin
+        );
+        // Road and ground near sea level (NAP): Amsterdam streets lie about 1 m below it.
+        assert!(zmin > -3.0 && zmax < 3.0, "{name}: z {zmin}..{zmax}");
+
+        // The same points as the las crate decodes them, after a stable sort by time.
+        let raw = read_raw(&path);
+        assert_eq!(raw.header_count, n, "{name}: header count");
+        let mut perm: Vec<usize> = (0..raw.t.len()).collect();
+        perm.sort_by(|&a, &b| raw.t[a].total_cmp(&raw.t[b]));
+        for (k, &i) in perm.iter().enumerate() {
+            assert_eq!(
+                (cols.x[k], cols.y[k], cols.z[k], cols.t[k]),
+                (raw.x[i], raw.y[i], raw.z[i], raw.t[i]),
+                "{name}: point {k} after sorting"
+            );
+        }
+        let out = path.to_string_lossy().contains("output_");
+        // Extra bytes: one `u8` label on the labelled files, an 8-byte `label` (all 0) on the
+        // input files.
+        assert_eq!(raw.extra_bytes, if out { 1 } else { 8 }, "{name}");
+        if out {
+            assert!(
+                raw.extra0.iter().all(|&l| l == 1 || l == 9),
+                "{name}: labels are 1 (road) or 9 (other ground)"
+            );
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// 2. extract with a trajectory that does not cover the tile
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn extract_on_a_real_tile_with_a_foreign_trajectory_fails_in_one_line() {
+    let Some(dir) = data(AMS, "extract_on_a_real_tile_with_a_foreign_trajectory…") else {
+        return;
+    };
+    let tile = dir.join("input_2294_9701.laz");
+    let tmp = tempfile::tempdir().unwrap();
+    // Two foreign trajectories: GPS week seconds (the classic mix-up), and the tile's own
+    // time base but an hour before its first point (2.83766048e8 s).
+    for (name, t0, hint) in [
+        ("week.csv", 1000.0, Some("GPS week seconds")),
+        ("earlier.csv", 283_762_000.0, None),
+    ] {
+        let traj = tmp.path().join(name);
+        let mut csv = String::from("time,x,y,z,roll,pitch,heading\n");
+        for k in 0..=100 {
+            let y = 485_050.0 + 0.5 * k as f64;
+            csv += &format!("{},114725.0,{y},1.5,0,0,0\n", t0 + 0.1 * k as f64);
+        }
+        std::fs::write(&traj, csv).unwrap();
+        let out = tmp.path().join("edges.geojson");
+        let run = Command::new(env!("CARGO_BIN_EXE_curbtrace"))
+            .arg("extract")
+            .arg(&tile)
+            .arg("--trajectory")
+            .arg(&traj)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "{name}: must fail");
+        let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+        assert_eq!(lines.len(), 1, "{name}: one line on stderr: {err}");
+        let line = lines[0];
+        assert!(line.contains(&tile.display().to_string()), "names the tile: {line}");
+        assert!(line.contains(&traj.display().to_string()), "names the trajectory: {line}");
+        if let Some(h) = hint {
+            assert!(line.contains(h), "{name}: hints at {h}: {line}");
+        }
+        assert!(!out.exists(), "{name}: no output on error");
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// 3. The kernel on virtual scanlines across the labelled curb line
+// ---------------------------------------------------------------------------------------
+
+/// Label of road points.
+const ROAD: u8 = 1;
+/// Label of other ground (mostly sidewalk).
+const SIDE: u8 = 9;
+
+/// Capacity of a virtual scanline (the densest slab of the dense tile has about 600 points).
+const N: usize = 4096;
+
+/// How the virtual scanlines are cut (fixed before measuring; see `docs/real-data.md`).
+#[derive(Clone, Copy, Debug)]
+struct Cut {
+    /// Spacing of the stations along the label boundary, metres.
+    station_m: f64,
+    /// Radius of the boundary neighbourhood whose principal axis gives the curb direction.
+    pca_radius_m: f64,
+    /// Largest ratio of the boundary's across- to along-spread (σ₂/σ₁) for a straight
+    /// enough boundary; corners and ragged label edges above it are skipped.
+    max_spread_ratio: f64,
+    /// Slab thickness along the curb, metres.
+    slab_m: f64,
+    /// Lateral distance of the virtual scanner from the label boundary, road side, metres.
+    scanner_offset_m: f64,
+    /// Scanner height above the road below it, metres.
+    scanner_height_m: f64,
+    /// The line runs from `road_reach_m` before the boundary to `side_reach_m` past it.
+    road_reach_m: f64,
+    /// See `road_reach_m`.
+    side_reach_m: f64,
+}
+
+const CUT: Cut = Cut {
+    station_m: 1.0,
+    pca_radius_m: 1.5,
+    max_spread_ratio: 0.25,
+    slab_m: 0.08,
+    scanner_offset_m: 2.5,
+    scanner_height_m: 2.0,
+    road_reach_m: 3.5,
+    side_reach_m: 1.5,
+};
+
+/// A labelled tile in local coordinates (minus the tile's corner), with a point grid.
+struct Tile {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+    label: Vec<u8>,
+    grid: Grid,
+}
+
+/// A uniform hash grid over point indices.
+struct Grid {
+    cell: f64,
+    cells: HashMap<(i64, i64), Vec<u32>>,
+}
+
+impl Grid {
+    fn new(x: &[f64], y: &[f64], cell: f64) -> Self {
+        let mut cells: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
+        for i in 0..x.len() {
+            cells
+                .entry(((x[i] / cell).floor() as i64, (y[i] / cell).floor() as i64))
+                .or_default()
+                .push(i as u32);
+        }
+        Self { cell, cells }
+    }
+
+    /// Indices of the points in the cells touching the square of half-side `r` around (x, y)
+    /// (a superset of those within `r`), in cell order then file order.
+    fn near(&self, x: f64, y: f64, r: f64) -> impl Iterator<Item = usize> + '_ {
+        let c = |v: f64| (v / self.cell).floor() as i64;
+        let (x0, x1, y0, y1) = (c(x - r), c(x + r), c(y - r), c(y + r));
+        (x0..=x1)
+            .flat_map(move |i| (y0..=y1).map(move |j| (i, j)))
+            .filter_map(|k| self.cells.get(&k))
+            .flatten()
+            .map(|&i| i as usize)
+    }
+}
+
+fn read_tile(path: &Path, col: i64, row: i64) -> Tile {
+    let raw = read_raw(path);
+    let (ox, oy) = (50.0 * col as f64, 50.0 * row as f64);
+    let x: Vec<f64> = raw.x.iter().map(|v| v - ox).collect();
+    let y: Vec<f64> = raw.y.iter().map(|v| v - oy).collect();
+    let grid = Grid::new(&x, &y, 0.5);
+    Tile {
+        x,
+        y,
+        z: raw.z,
+        label: raw.extra0,
+        grid,
+    }
+}
+
+fn median(v: &mut [f64]) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    Some(v[v.len() / 2])
+}
+
+/// What happened on one virtual scanline.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Outcome {
+    /// The left candidate lies this far (metres, lateral) from the label boundary.
+    Candidate(f64),
+    /// The kernel gave no left candidate.
+    NoCandidate,
+}
+
+/// One virtual scanline: its points, the boundary, and measurements independent of the
+/// kernel.
+struct Slab {
+    /// Lateral offset from the station, metres (road negative, sidewalk positive), sorted.
+    u: Vec<f64>,
+    z: Vec<f64>,
+    /// Label boundary (lateral offset).
+    u_b: f64,
+    /// Scanner position (lateral offset) and height.
+    u_s: f64,
+    z_s: f64,
+    /// Median sidewalk height minus median road height beside the boundary (0.1–0.6 m off).
+    step_m: f64,
+    /// Median gap between consecutive points within 0.5 m of the boundary.
+    spacing_m: f64,
+}
+
+/// Why a station gave no slab.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+enum Skip {
+    /// The label boundary around the station is not straight (corner, ragged labels).
+    NotStraight,
+    /// No clean road|sidewalk crossing: too few points, or the labels do not change from
+    /// road (where the scanner stands) to other ground (past the boundary).
+    NotACrossing,
+}
+
+/// Stations along the label boundary: points with a point of the other label within
+/// 0.15 m, thinned greedily (file order) to one per `CUT.station_m`.
+fn stations(tile: &Tile) -> (Vec<usize>, Vec<usize>) {
+    let r2 = 0.15f64 * 0.15;
+    let boundary: Vec<usize> = (0..tile.x.len())
+        .filter(|&i| {
+            tile.grid.near(tile.x[i], tile.y[i], 0.15).any(|j| {
+                tile.label[j] != tile.label[i]
+                    && (tile.x[j] - tile.x[i]).powi(2) + (tile.y[j] - tile.y[i]).powi(2) <= r2
+            })
+        })
+        .collect();
+    let mut taken: Vec<usize> = Vec::new();
+    let mut tgrid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    let s = CUT.station_m;
+    for &i in &boundary {
+        let (cx, cy) = ((tile.x[i] / s).floor() as i64, (tile.y[i] / s).floor() as i64);
+        let close = (cx - 1..=cx + 1)
+            .flat_map(|a| (cy - 1..=cy + 1).map(move |b| (a, b)))
+            .filter_map(|k| tgrid.get(&k))
+            .flatten()
+            .any(|&j| (tile.x[j] - tile.x[i]).hypot(tile.y[j] - tile.y[i]) < s);
+        if !close {
+            taken.push(i);
+            tgrid.entry((cx, cy)).or_default().push(i);
+        }
+    }
+    (boundary, taken)
+}
+
+/// Cuts the virtual scanline at station `c` (see `docs/real-data.md` for the recipe).
+fn cut_slab(tile: &Tile, bgrid: &Grid, boundary: &[usize], c: usize) -> Result<Slab, Skip> {
+    let (cx, cy) = (tile.x[c], tile.y[c]);
+    // Curb direction: principal axis of the boundary points around the station.
+    let r = CUT.pca_radius_m;
+    let nb: Vec<usize> = bgrid
+        .near(cx, cy, r)
+        .map(|k| boundary[k])
+        .filter(|&j| (tile.x[j] - cx).hypot(tile.y[j] - cy) <= r)
+        .collect();
+    if nb.len() < 5 {
+        return Err(Skip::NotStraight);
+    }
+    let m = nb.len() as f64;
+    let (mx, my) = nb
+        .iter()
+        .fold((0.0, 0.0), |(a, b), &j| (a + tile.x[j] / m, b + tile.y[j] / m));
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for &j in &nb {
+        let (dx, dy) = (tile.x[j] - mx, tile.y[j] - my);
+        sxx += dx * dx / m;
+        sxy += dx * dy / m;
+        syy += dy * dy / m;
+    }
+    let tr = sxx + syy;
+    let disc = ((sxx - syy).powi(2) / 4.0 + sxy * sxy).sqrt();
+    let (l1, l2) = (tr / 2.0 + disc, (tr / 2.0 - disc).max(0.0));
+    if l1 <= 0.0 || (l2 / l1).sqrt() > CUT.max_spread_ratio {
+        return Err(Skip::NotStraight);
+    }
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let (dx, dy) = (theta.cos(), theta.sin());
+    let (mut nx, mut ny) = (-dy, dx);
+
+    // Points of the slab: within half the thickness along the curb, lateral offset u.
+    let reach = CUT.road_reach_m.max(CUT.side_reach_m) + 0.6;
+    let mut pts: Vec<(f64, f64, u8)> = tile
+        .grid
+        .near(cx, cy, reach)
+        .filter_map(|j| {
+            let (px, py) = (tile.x[j] - cx, tile.y[j] - cy);
+            let along = px * dx + py * dy;
+            let u = px * nx + py * ny;
+            (along.abs() <= CUT.slab_m / 2.0 && u.abs() <= reach)
+                .then_some((u, tile.z[j], tile.label[j]))
+        })
+        .collect();
+    // Road towards negative u.
+    let mean_u = |l: u8| {
+        let v: Vec<f64> = pts
+            .iter()
+            .filter(|p| p.2 == l && p.0.abs() < 1.5)
+            .map(|p| p.0)
+            .collect();
+        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+    };
+    let (Some(mr), Some(ms)) = (mean_u(ROAD), mean_u(SIDE)) else {
+        return Err(Skip::NotACrossing);
+    };
+    if mr > ms {
+        (nx, ny) = (-nx, -ny);
+        for p in &mut pts {
+            p.0 = -p.0;
+        }
+    }
+    let _ = (nx, ny);
+    pts.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+
+    // Label boundary: the threshold within ±0.5 m that best separates road (below) from
+    // other ground (above) among the points within 1 m.
+    let near: Vec<&(f64, f64, u8)> = pts.iter().filter(|p| p.0.abs() <= 1.0).collect();
+    let mut best = (usize::MAX, 0.0);
+    // Misclassified with the threshold before point k: side points before it, road after.
+    let road_after: usize = near.iter().filter(|p| p.2 == ROAD).count();
+    let (mut side_before, mut road_rest) = (0usize, road_after);
+    for k in 0..=near.len() {
+        let thr = match k {
+            0 => near.first().map_or(0.0, |p| p.0 - 1e-3),
+            k if k == near.len() => near[k - 1].0 + 1e-3,
+            k => 0.5 * (near[k - 1].0 + near[k].0),
+        };
+        if thr.abs() <= 0.5 && side_before + road_rest < best.0 {
+            best = (side_before + road_rest, thr);
+        }
+        if let Some(p) = near.get(k) {
+            if p.2 == SIDE {
+                side_before += 1;
+            } else {
+                road_rest -= 1;
+            }
+        }
+    }
+    if best.0 == usize::MAX {
+        return Err(Skip::NotACrossing);
+    }
+    let u_b = best.1;
+    let u_s = u_b - CUT.scanner_offset_m;
+    let frac = |lo: f64, hi: f64, l: u8| {
+        let inside: Vec<_> = pts.iter().filter(|p| p.0 >= lo && p.0 < hi).collect();
+        let n = inside.len();
+        (n, inside.iter().filter(|p| p.2 == l).count() as f64 / n.max(1) as f64)
+    };
+    // A clean crossing: road under and around the scanner, other ground past the boundary.
+    let (n_road, f_road) = frac(u_s - 0.5, u_s + 0.5, ROAD);
+    let (n_side, f_side) = frac(u_b + 0.3, u_b + CUT.side_reach_m, SIDE);
+    if n_road < 3 || f_road < 0.8 || n_side < 3 || f_side < 0.8 {
+        return Err(Skip::NotACrossing);
+    }
+    let band = |lo: f64, hi: f64| {
+        let mut v: Vec<f64> = pts
+            .iter()
+            .filter(|p| p.0 >= lo && p.0 < hi)
+            .map(|p| p.1)
+            .collect();
+        median(&mut v)
+    };
+    let z_road = band(u_s - 0.3, u_s + 0.3).ok_or(Skip::NotACrossing)?;
+    let step_m = match (band(u_b + 0.1, u_b + 0.6), band(u_b - 0.6, u_b - 0.1)) {
+        (Some(s), Some(r)) => s - r,
+        _ => return Err(Skip::NotACrossing),
+    };
+    let lo = u_b - CUT.road_reach_m;
+    let hi = u_b + CUT.side_reach_m;
+    pts.retain(|p| p.0 >= lo && p.0 <= hi);
+    let mut gaps: Vec<f64> = pts
+        .windows(2)
+        .filter(|w| (w[0].0 - u_b).abs() <= 0.5 && (w[1].0 - u_b).abs() <= 0.5)
+        .map(|w| w[1].0 - w[0].0)
+        .collect();
+    Ok(Slab {
+        u: pts.iter().map(|p| p.0).collect(),
+        z: pts.iter().map(|p| p.1).collect(),
+        u_b,
+        u_s,
+        z_s: z_road + CUT.scanner_height_m,
+        step_m,
+        spacing_m: median(&mut gaps).unwrap_or(f64::INFINITY),
+    })
+}
+
+/// Runs the shipped kernel on a slab: the points in order of u (one side to the other, as a
+/// profiler sweeps), x′ = u − u_s (the sidewalk is on the left), z′ = z − z_s. Returns the
+/// outcome and the largest ρ of a kept point within 0.2 m of the boundary.
+fn run_kernel(kernel: &mut Kernel<N>, line: &mut Line<N>, slab: &Slab) -> (Outcome, f32) {
+    line.clear();
+    for (k, (&u, &z)) in slab.u.iter().zip(&slab.z).enumerate() {
+        // Lines longer than N are truncated by `push` and counted in `truncated`.
+        let _ = line.push((u - slab.u_s) as f32, (z - slab.z_s) as f32, k as u32);
+    }
+    let out = kernel.process(line);
+    let mut rho_max = f32::NEG_INFINITY;
+    for i in 0..out.tag.len() {
+        let u = slab.u[out.tag[i] as usize];
+        if out.status[i] == PointStatus::Kept && (u - slab.u_b).abs() <= 0.2 {
+            rho_max = rho_max.max(out.rho_deg[i]);
+        }
+    }
+    let outcome = match out.left {
+        Some(i) => Outcome::Candidate((slab.u[out.tag[usize::from(i)] as usize] - slab.u_b).abs()),
+        None => Outcome::NoCandidate,
+    };
+    (outcome, rho_max)
+}
+
+/// Everything measured on one tile with one parameter set.
+#[derive(Debug, Default)]
+struct Tally {
+    stations: usize,
+    skipped: HashMap<Skip, usize>,
+    slabs: usize,
+    within_01: usize,
+    within_02: usize,
+    elsewhere: usize,
+    none: usize,
+    steps: Vec<f64>,
+    spacings: Vec<f64>,
+    rho_near: Vec<f64>,
+    points: Vec<f64>,
+}
+
+impl Tally {
+    fn rate(&self, k: usize) -> f64 {
+        k as f64 / self.slabs.max(1) as f64
+    }
+}
+
+fn measure(tile: &Tile, params: KernelParams) -> Tally {
+    let (boundary, st) = stations(tile);
+    let bx: Vec<f64> = boundary.iter().map(|&i| tile.x[i]).collect();
+    let by: Vec<f64> = boundary.iter().map(|&i| tile.y[i]).collect();
+    let bgrid = Grid::new(&bx, &by, 0.5);
+    let mut kernel = Box::new(Kernel::<N>::new(params));
+    kernel.set_params(params).expect("valid parameters");
+    let mut line = Box::new(Line::<N>::new());
+    let mut t = Tally {
+        stations: st.len(),
+        ..Tally::default()
+    };
+    for &c in &st {
+        let slab = match cut_slab(tile, &bgrid, &boundary, c) {
+            Ok(s) => s,
+            Err(why) => {
+                *t.skipped.entry(why).or_default() += 1;
+                continue;
+            }
+        };
+        t.slabs += 1;
+        t.steps.push(slab.step_m);
+        t.spacings.push(slab.spacing_m);
+        t.points.push(slab.u.len() as f64);
+        let (outcome, rho) = run_kernel(&mut kernel, &mut line, &slab);
+        if rho.is_finite() {
+            t.rho_near.push(f64::from(rho));
+        }
+        match outcome {
+            Outcome::Candidate(d) if d <= 0.1 => t.within_01 += 1,
+            Outcome::Candidate(d) if d <= 0.2 => t.within_02 += 1,
+            Outcome::Candidate(_) => t.elsewhere += 1,
+            Outcome::NoCandidate => t.none += 1,
+        }
+    }
+    t.within_02 += t.within_01;
+    t
+}
+
+fn quantiles(v: &[f64]) -> String {
+    let mut v = v.to_vec();
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        return "-".into();
+    }
+    let q = |f: f64| v[((v.len() - 1) as f64 * f).round() as usize];
+    format!("{:.3} / {:.3} / {:.3}", q(0.25), q(0.5), q(0.75))
+}
+
+fn load_labelled(dir: &Path, name: &str) -> Tile {
+    let &(_, _, col, row) = TILES.iter().find(|x| x.0 == name).unwrap();
+    read_tile(&labelled_path(dir, name), col, row)
+}
+
+/// The parameter sets of the experiment: the shipped defaults first.
+fn variants() -> Vec<(&'static str, KernelParams)> {
+    let d = KernelParams::DEFAULT;
+    vec![
+        ("default (d_b 0.07, τmin 35°)", d),
+        ("d_b 0.05", KernelParams { d_b_m: 0.05, ..d }),
+        ("d_b 0.10", KernelParams { d_b_m: 0.10, ..d }),
+        ("τmin 20°", KernelParams { tau_min_deg: 20.0, ..d }),
+        ("τmin 15°", KernelParams { tau_min_deg: 15.0, ..d }),
+        (
+            "d_b 0.10, τmin 15°",
+            KernelParams {
+                d_b_m: 0.10,
+                tau_min_deg: 15.0,
+                ..d
+            },
+        ),
+    ]
+}
+
+/// Prints the whole measurement (every tile, every parameter set). Run with
+/// `cargo test --release -p curbtrace-host-sim --test real_data -- --ignored --nocapture`.
+#[test]
+#[ignore = "prints the real-data measurement of docs/real-data.md"]
+fn virtual_scanline_report() {
+    let Some(dir) = data(AMS, "virtual_scanline_report") else {
+        return;
+    };
+    for name in LABELLED {
+        let tile = load_labelled(&dir, name);
+        println!("tile {name}: {} points", tile.x.len());
+        for (k, (what, p)) in variants().into_iter().enumerate() {
+            let t = measure(&tile, p);
+            if k == 0 {
+                println!(
+                    "  stations {}, skipped {:?}, slabs {}",
+                    t.stations, t.skipped, t.slabs
+                );
+                println!("  points per slab q25/50/75 {}", quantiles(&t.points));
+                println!("  spacing at boundary (m)   {}", quantiles(&t.spacings));
+                println!("  step at boundary (m)      {}", quantiles(&t.steps));
+            }
+            println!(
+                "  {what:<28} ≤0.1 m {:5.1} %  ≤0.2 m {:5.1} %  elsewhere {:5.1} %  none {:5.1} %  max ρ within 0.2 m (°) {}",
+                100.0 * t.rate(t.within_01),
+                100.0 * t.rate(t.within_02),
+                100.0 * t.rate(t.elsewhere),
+                100.0 * t.rate(t.none),
+                quantiles(&t.rho_near),
+            );
+        }
+    }
+}
