@@ -264,22 +264,26 @@ struct Cut {
     slab_m: f64,
     /// Lateral distance of the virtual scanner from the label boundary, road side, metres.
     scanner_offset_m: f64,
+    /// The closest the scanner may come to the boundary (see `cut_slab`).
+    min_scanner_offset_m: f64,
     /// Scanner height above the road below it, metres.
     scanner_height_m: f64,
-    /// The line runs from `road_reach_m` before the boundary to `side_reach_m` past it.
-    road_reach_m: f64,
-    /// See `road_reach_m`.
+    /// The line runs from `right_reach_m` past the scanner's foot (its right side) to
+    /// `side_reach_m` past the boundary.
+    right_reach_m: f64,
+    /// See `right_reach_m`.
     side_reach_m: f64,
 }
 
 const CUT: Cut = Cut {
-    station_m: 1.0,
+    station_m: 0.5,
     pca_radius_m: 1.5,
     max_spread_ratio: 0.25,
     slab_m: 0.08,
     scanner_offset_m: 2.5,
+    min_scanner_offset_m: 1.0,
     scanner_height_m: 2.0,
-    road_reach_m: 3.5,
+    right_reach_m: 1.0,
     side_reach_m: 1.5,
 };
 
@@ -349,7 +353,8 @@ fn median(v: &mut [f64]) -> Option<f64> {
 /// What happened on one virtual scanline.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Outcome {
-    /// The left candidate lies this far (metres, lateral) from the label boundary.
+    /// The left candidate lies this far (metres, lateral) from the label boundary, negative
+    /// on the road side.
     Candidate(f64),
     /// The kernel gave no left candidate.
     NoCandidate,
@@ -377,9 +382,12 @@ struct Slab {
 enum Skip {
     /// The label boundary around the station is not straight (corner, ragged labels).
     NotStraight,
-    /// No clean road|sidewalk crossing: too few points, or the labels do not change from
-    /// road (where the scanner stands) to other ground (past the boundary).
+    /// No clean road|sidewalk crossing: too few points or one label missing.
     NotACrossing,
+    /// Fewer than 3 points or under 80 % road within 0.5 m of the virtual scanner's foot.
+    RoadNotUnderScanner,
+    /// Fewer than 3 points or under 80 % other ground from 0.3 m past the boundary on.
+    NoOtherGroundPast,
 }
 
 /// Stations along the label boundary: points with a point of the other label within
@@ -447,7 +455,7 @@ fn cut_slab(tile: &Tile, bgrid: &Grid, boundary: &[usize], c: usize) -> Result<S
     let (mut nx, mut ny) = (-dy, dx);
 
     // Points of the slab: within half the thickness along the curb, lateral offset u.
-    let reach = CUT.road_reach_m.max(CUT.side_reach_m) + 0.6;
+    let reach = (CUT.scanner_offset_m + CUT.right_reach_m).max(CUT.side_reach_m) + 0.6;
     let mut pts: Vec<(f64, f64, u8)> = tile
         .grid
         .near(cx, cy, reach)
@@ -508,18 +516,30 @@ fn cut_slab(tile: &Tile, bgrid: &Grid, boundary: &[usize], c: usize) -> Result<S
         return Err(Skip::NotACrossing);
     }
     let u_b = best.1;
-    let u_s = u_b - CUT.scanner_offset_m;
     let frac = |lo: f64, hi: f64, l: u8| {
         let inside: Vec<_> = pts.iter().filter(|p| p.0 >= lo && p.0 < hi).collect();
         let n = inside.len();
         (n, inside.iter().filter(|p| p.2 == l).count() as f64 / n.max(1) as f64)
     };
-    // A clean crossing: road under and around the scanner, other ground past the boundary.
-    let (n_road, f_road) = frac(u_s - 0.5, u_s + 0.5, ROAD);
+    // A clean crossing: other ground past the boundary, and road under and around the
+    // scanner — at `scanner_offset_m` from the boundary, or closer (in steps of 0.5 m, down
+    // to `min_scanner_offset_m`) where the labelled road within the tile is narrower.
     let (n_side, f_side) = frac(u_b + 0.3, u_b + CUT.side_reach_m, SIDE);
-    if n_road < 3 || f_road < 0.8 || n_side < 3 || f_side < 0.8 {
-        return Err(Skip::NotACrossing);
+    if n_side < 3 || f_side < 0.8 {
+        return Err(Skip::NoOtherGroundPast);
     }
+    let mut offset = CUT.scanner_offset_m;
+    let u_s = loop {
+        let u_s = u_b - offset;
+        let (n_road, f_road) = frac(u_s - 0.5, u_s + 0.5, ROAD);
+        if n_road >= 3 && f_road >= 0.8 {
+            break u_s;
+        }
+        offset -= 0.5;
+        if offset < CUT.min_scanner_offset_m - 1e-9 {
+            return Err(Skip::RoadNotUnderScanner);
+        }
+    };
     let band = |lo: f64, hi: f64| {
         let mut v: Vec<f64> = pts
             .iter()
@@ -533,7 +553,7 @@ fn cut_slab(tile: &Tile, bgrid: &Grid, boundary: &[usize], c: usize) -> Result<S
         (Some(s), Some(r)) => s - r,
         _ => return Err(Skip::NotACrossing),
     };
-    let lo = u_b - CUT.road_reach_m;
+    let lo = u_s - CUT.right_reach_m;
     let hi = u_b + CUT.side_reach_m;
     pts.retain(|p| p.0 >= lo && p.0 <= hi);
     let mut gaps: Vec<f64> = pts
@@ -570,7 +590,7 @@ fn run_kernel(kernel: &mut Kernel<N>, line: &mut Line<N>, slab: &Slab) -> (Outco
         }
     }
     let outcome = match out.left {
-        Some(i) => Outcome::Candidate((slab.u[out.tag[usize::from(i)] as usize] - slab.u_b).abs()),
+        Some(i) => Outcome::Candidate(slab.u[out.tag[usize::from(i)] as usize] - slab.u_b),
         None => Outcome::NoCandidate,
     };
     (outcome, rho_max)
@@ -584,8 +604,13 @@ struct Tally {
     slabs: usize,
     within_01: usize,
     within_02: usize,
-    elsewhere: usize,
+    /// Candidates farther than 0.2 m on the road side (between the scanner and the curb).
+    before: usize,
+    /// Candidates farther than 0.2 m on the other-ground side.
+    after: usize,
     none: usize,
+    /// Per step class (< 4 cm, 4–6 cm, ≥ 6 cm): slabs and candidates within 0.2 m.
+    by_step: [(usize, usize); 3],
     steps: Vec<f64>,
     spacings: Vec<f64>,
     rho_near: Vec<f64>,
@@ -626,11 +651,21 @@ fn measure(tile: &Tile, params: KernelParams) -> Tally {
         if rho.is_finite() {
             t.rho_near.push(f64::from(rho));
         }
+        let class = match slab.step_m {
+            s if s < 0.04 => 0,
+            s if s < 0.06 => 1,
+            _ => 2,
+        };
+        t.by_step[class].0 += 1;
         match outcome {
-            Outcome::Candidate(d) if d <= 0.1 => t.within_01 += 1,
-            Outcome::Candidate(d) if d <= 0.2 => t.within_02 += 1,
-            Outcome::Candidate(_) => t.elsewhere += 1,
+            Outcome::Candidate(d) if d.abs() <= 0.1 => t.within_01 += 1,
+            Outcome::Candidate(d) if d.abs() <= 0.2 => t.within_02 += 1,
+            Outcome::Candidate(d) if d < 0.0 => t.before += 1,
+            Outcome::Candidate(_) => t.after += 1,
             Outcome::NoCandidate => t.none += 1,
+        }
+        if matches!(outcome, Outcome::Candidate(d) if d.abs() <= 0.2) {
+            t.by_step[class].1 += 1;
         }
     }
     t.within_02 += t.within_01;
@@ -695,13 +730,69 @@ fn virtual_scanline_report() {
                 println!("  step at boundary (m)      {}", quantiles(&t.steps));
             }
             println!(
-                "  {what:<28} ≤0.1 m {:5.1} %  ≤0.2 m {:5.1} %  elsewhere {:5.1} %  none {:5.1} %  max ρ within 0.2 m (°) {}",
+                "  {what:<28} ≤0.1 m {:2} ({:4.1} %)  ≤0.2 m {:2} ({:4.1} %)  road side {:2}  beyond {:2}  none {:2}  by step <4/4–6/≥6 cm {:?}  max ρ within 0.2 m (°) {}",
+                t.within_01,
                 100.0 * t.rate(t.within_01),
+                t.within_02,
                 100.0 * t.rate(t.within_02),
-                100.0 * t.rate(t.elsewhere),
-                100.0 * t.rate(t.none),
+                t.before,
+                t.after,
+                t.none,
+                t.by_step,
                 quantiles(&t.rho_near),
             );
         }
     }
+}
+
+/// The shipped kernel with its default parameters on the virtual scanlines of the dense
+/// labelled tile (2293_9698): a floor under the rate of left candidates near the label
+/// boundary, and the sampling fact behind the misses (see `docs/real-data.md`).
+///
+/// Measured (release and debug give the same numbers; the computation is deterministic):
+/// 59 slabs, 14 candidates within 0.1 m (23.7 %), 18 within 0.2 m (30.5 %). The floors are
+/// these rates minus about 2.5 binomial standard errors (√(p(1−p)/59) ≈ 5.5–6 %), so that
+/// small changes to the kernel's numerics (libm against micromath) or to how the slabs are
+/// cut can move a few borderline slabs without failing, while a kernel that stopped finding
+/// real curbs, or found them only by chance, fails: a left candidate placed at random on
+/// the left part of the line (≈4 m, from the scanner's foot to 1.5 m past the boundary)
+/// would land within ±0.2 m about 10 % of the time and within ±0.1 m about 5 %.
+#[test]
+fn kernel_finds_real_curbs_on_virtual_scanlines() {
+    let Some(dir) = data(AMS, "kernel_finds_real_curbs_on_virtual_scanlines") else {
+        return;
+    };
+    let tile = load_labelled(&dir, "2293_9698");
+    let t = measure(&tile, KernelParams::DEFAULT);
+    eprintln!(
+        "2293_9698, default kernel: {} slabs, {} within 0.1 m, {} within 0.2 m, {} on the road side, {} beyond, {} without candidate",
+        t.slabs, t.within_01, t.within_02, t.before, t.after, t.none
+    );
+    assert!(t.slabs >= 50, "the cut must yield enough slabs: {}", t.slabs);
+    assert!(
+        t.rate(t.within_01) >= 0.10,
+        "within 0.1 m: {} of {}",
+        t.within_01,
+        t.slabs
+    );
+    assert!(
+        t.rate(t.within_02) >= 0.15,
+        "within 0.2 m: {} of {}",
+        t.within_02,
+        t.slabs
+    );
+    // The misses are not for want of points: at the boundary the slabs are sampled more
+    // densely than d_b (median gap 8 mm here against d_b = 70 mm), as densely as a
+    // profiler's line near the scanner.
+    let mut gaps = t.spacings.clone();
+    let gap = median(&mut gaps).unwrap();
+    assert!(
+        gap < f64::from(KernelParams::DEFAULT.d_b_m) / 3.0,
+        "median spacing at the boundary {gap} m"
+    );
+    // The curbs are low, as the data's README says (sidewalk a median 3.4 cm above the
+    // road over all tiles): the median step across these slabs is 3–8 cm.
+    let mut steps = t.steps.clone();
+    let step = median(&mut steps).unwrap();
+    assert!((0.03..0.08).contains(&step), "median step {step} m");
 }
