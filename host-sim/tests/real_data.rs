@@ -94,7 +94,9 @@ fn read_raw(path: &Path) -> Raw {
     let mut r = las::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let header_count = r.header().number_of_points();
     let extra_bytes = r.header().point_format().extra_bytes;
-    let pd = r.read_all().unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let pd = r
+        .read_all()
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut raw = Raw {
         x: pd.x().collect(),
         y: pd.y().collect(),
@@ -141,7 +143,10 @@ fn amsterdam_tiles_read_through_las_in() {
         assert_eq!(info.crs, None, "{name}: the file states no CRS");
         // The scan angle is 0 everywhere in these files: line starts cannot come from it.
         assert!(!info.has_scan_angle, "{name}");
-        assert!(cols.t.windows(2).all(|w| w[0] <= w[1]), "{name}: time order");
+        assert!(
+            cols.t.windows(2).all(|w| w[0] <= w[1]),
+            "{name}: time order"
+        );
         // Several passes per tile: the times span about a day (2.8e8 s adjusted GPS time).
         let (t0, t1) = cols.time_range().unwrap();
         assert!(t0 > 2.8e8 && t1 < 2.9e8, "{name}: times {t0}..{t1}");
@@ -229,8 +234,14 @@ fn extract_on_a_real_tile_with_a_foreign_trajectory_fails_in_one_line() {
         let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
         assert_eq!(lines.len(), 1, "{name}: one line on stderr: {err}");
         let line = lines[0];
-        assert!(line.contains(&tile.display().to_string()), "names the tile: {line}");
-        assert!(line.contains(&traj.display().to_string()), "names the trajectory: {line}");
+        assert!(
+            line.contains(&tile.display().to_string()),
+            "names the tile: {line}"
+        );
+        assert!(
+            line.contains(&traj.display().to_string()),
+            "names the trajectory: {line}"
+        );
         if let Some(h) = hint {
             assert!(line.contains(h), "{name}: hints at {h}: {line}");
         }
@@ -406,7 +417,10 @@ fn stations(tile: &Tile) -> (Vec<usize>, Vec<usize>) {
     let mut tgrid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
     let s = CUT.station_m;
     for &i in &boundary {
-        let (cx, cy) = ((tile.x[i] / s).floor() as i64, (tile.y[i] / s).floor() as i64);
+        let (cx, cy) = (
+            (tile.x[i] / s).floor() as i64,
+            (tile.y[i] / s).floor() as i64,
+        );
         let close = (cx - 1..=cx + 1)
             .flat_map(|a| (cy - 1..=cy + 1).map(move |b| (a, b)))
             .filter_map(|k| tgrid.get(&k))
@@ -434,9 +448,9 @@ fn cut_slab(tile: &Tile, bgrid: &Grid, boundary: &[usize], c: usize) -> Result<S
         return Err(Skip::NotStraight);
     }
     let m = nb.len() as f64;
-    let (mx, my) = nb
-        .iter()
-        .fold((0.0, 0.0), |(a, b), &j| (a + tile.x[j] / m, b + tile.y[j] / m));
+    let (mx, my) = nb.iter().fold((0.0, 0.0), |(a, b), &j| {
+        (a + tile.x[j] / m, b + tile.y[j] / m)
+    });
     let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
     for &j in &nb {
         let (dx, dy) = (tile.x[j] - mx, tile.y[j] - my);
@@ -463,8 +477,11 @@ fn cut_slab(tile: &Tile, bgrid: &Grid, boundary: &[usize], c: usize) -> Result<S
             let (px, py) = (tile.x[j] - cx, tile.y[j] - cy);
             let along = px * dx + py * dy;
             let u = px * nx + py * ny;
-            (along.abs() <= CUT.slab_m / 2.0 && u.abs() <= reach)
-                .then_some((u, tile.z[j], tile.label[j]))
+            (along.abs() <= CUT.slab_m / 2.0 && u.abs() <= reach).then_some((
+                u,
+                tile.z[j],
+                tile.label[j],
+            ))
         })
         .collect();
     // Road towards negative u.
@@ -519,7 +536,10 @@ fn cut_slab(tile: &Tile, bgrid: &Grid, boundary: &[usize], c: usize) -> Result<S
     let frac = |lo: f64, hi: f64, l: u8| {
         let inside: Vec<_> = pts.iter().filter(|p| p.0 >= lo && p.0 < hi).collect();
         let n = inside.len();
-        (n, inside.iter().filter(|p| p.2 == l).count() as f64 / n.max(1) as f64)
+        (
+            n,
+            inside.iter().filter(|p| p.2 == l).count() as f64 / n.max(1) as f64,
+        )
     };
     // A clean crossing: other ground past the boundary, and road under and around the
     // scanner — at `scanner_offset_m` from the boundary, or closer (in steps of 0.5 m, down
@@ -694,8 +714,20 @@ fn variants() -> Vec<(&'static str, KernelParams)> {
         ("default (d_b 0.07, τmin 35°)", d),
         ("d_b 0.05", KernelParams { d_b_m: 0.05, ..d }),
         ("d_b 0.10", KernelParams { d_b_m: 0.10, ..d }),
-        ("τmin 20°", KernelParams { tau_min_deg: 20.0, ..d }),
-        ("τmin 15°", KernelParams { tau_min_deg: 15.0, ..d }),
+        (
+            "τmin 20°",
+            KernelParams {
+                tau_min_deg: 20.0,
+                ..d
+            },
+        ),
+        (
+            "τmin 15°",
+            KernelParams {
+                tau_min_deg: 15.0,
+                ..d
+            },
+        ),
         (
             "d_b 0.10, τmin 15°",
             KernelParams {
@@ -768,7 +800,11 @@ fn kernel_finds_real_curbs_on_virtual_scanlines() {
         "2293_9698, default kernel: {} slabs, {} within 0.1 m, {} within 0.2 m, {} on the road side, {} beyond, {} without candidate",
         t.slabs, t.within_01, t.within_02, t.before, t.after, t.none
     );
-    assert!(t.slabs >= 50, "the cut must yield enough slabs: {}", t.slabs);
+    assert!(
+        t.slabs >= 50,
+        "the cut must yield enough slabs: {}",
+        t.slabs
+    );
     assert!(
         t.rate(t.within_01) >= 0.10,
         "within 0.1 m: {} of {}",
