@@ -16,8 +16,11 @@
 //!    *virtual scanlines* cut from the labelled tiles across the road|sidewalk boundary:
 //!    how often its left seed candidate lies within 0.1 m / 0.2 m of the label boundary.
 
+use curbtrace_core::kernel::ScanlineOutput;
 use curbtrace_core::kernel::{Kernel, KernelParams, PointStatus};
+use curbtrace_core::pipeline::Pipeline;
 use curbtrace_core::scanline::Line;
+use curbtrace_core::wire::{PointRecord, StreamEncoder, MAX_PACKET_LEN, MAX_POINTS_PER_PACKET};
 use curbtrace_host_sim::io::las_in::{read_points, ReadOptions};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -594,8 +597,13 @@ fn cut_slab(tile: &Tile, bgrid: &Grid, boundary: &[usize], c: usize) -> Result<S
 
 /// Runs the shipped kernel on a slab: the points in order of u (one side to the other, as a
 /// profiler sweeps), x′ = u − u_s (the sidewalk is on the left), z′ = z − z_s. Returns the
-/// outcome and the largest ρ of a kept point within 0.2 m of the boundary.
-fn run_kernel(kernel: &mut Kernel<N>, line: &mut Line<N>, slab: &Slab) -> (Outcome, f32) {
+/// outcome, the largest ρ of a kept point within 0.2 m of the boundary, and the left
+/// candidate's tag (its index in the slab).
+fn run_kernel(
+    kernel: &mut Kernel<N>,
+    line: &mut Line<N>,
+    slab: &Slab,
+) -> (Outcome, f32, Option<u32>) {
     line.clear();
     for (k, (&u, &z)) in slab.u.iter().zip(&slab.z).enumerate() {
         // Lines longer than N are truncated by `push` and counted in `truncated`.
@@ -609,11 +617,62 @@ fn run_kernel(kernel: &mut Kernel<N>, line: &mut Line<N>, slab: &Slab) -> (Outco
             rho_max = rho_max.max(out.rho_deg[i]);
         }
     }
-    let outcome = match out.left {
-        Some(i) => Outcome::Candidate(slab.u[out.tag[usize::from(i)] as usize] - slab.u_b),
+    let left = out.left.map(|i| out.tag[usize::from(i)]);
+    let outcome = match left {
+        Some(k) => Outcome::Candidate(slab.u[k as usize] - slab.u_b),
         None => Outcome::NoCandidate,
     };
-    (outcome, rho_max)
+    (outcome, rho_max, left)
+}
+
+/// The same lines through the on-board path: encoded as wire packets (one line per slab,
+/// the line-start flag on its first point, 10 ms apart as at 100 lines/s), written into a
+/// `Pipeline` ring and assembled there. Returns each line's left candidate tag, in order.
+fn pipeline_left_tags(lines: &[Vec<[f32; 2]>]) -> Vec<Option<u32>> {
+    let mut pipe = Box::new(Pipeline::<16384, N>::new());
+    let mut enc = StreamEncoder::new();
+    let mut buf = [0u8; MAX_PACKET_LEN];
+    let mut got = Vec::new();
+    let mut collect =
+        |out: &ScanlineOutput<'_>| got.push(out.left.map(|i| out.tag[usize::from(i)]));
+    for (k, pts) in lines.iter().enumerate() {
+        let recs: Vec<PointRecord> = pts
+            .iter()
+            .enumerate()
+            .map(|(i, p)| PointRecord {
+                dt_ns: i as u32 * 1000,
+                x_m: p[0],
+                z_m: p[1],
+                intensity: 0,
+                line_start: i == 0,
+                tag: i as u32,
+            })
+            .collect();
+        for (c, chunk) in recs.chunks(MAX_POINTS_PER_PACKET).enumerate() {
+            let base =
+                1_000_000_000 + k as u64 * 10_000_000 + (c * MAX_POINTS_PER_PACKET) as u64 * 1000;
+            let chunk: Vec<PointRecord> = chunk
+                .iter()
+                .map(|r| PointRecord {
+                    dt_ns: r.dt_ns - (c * MAX_POINTS_PER_PACKET) as u32 * 1000,
+                    ..*r
+                })
+                .collect();
+            let n = enc.encode_points(base, &chunk, &mut buf).expect("encode");
+            assert_eq!(pipe.write(&buf[..n]), n, "the ring takes every packet");
+            pipe.run(&mut collect);
+        }
+    }
+    pipe.finish(&mut collect);
+    let c = pipe.counters();
+    let points: usize = lines.iter().map(Vec::len).sum();
+    assert_eq!(c.ingest.crc_errors, 0);
+    assert_eq!(
+        c.kernel_points, points as u64,
+        "every point reached the kernel"
+    );
+    assert_eq!(c.kernel_lines, lines.len() as u64, "one line per slab");
+    got
 }
 
 /// Everything measured on one tile with one parameter set.
@@ -635,6 +694,8 @@ struct Tally {
     spacings: Vec<f64>,
     rho_near: Vec<f64>,
     points: Vec<f64>,
+    /// Each slab's line (x′, z′) and the kernel's left candidate tag.
+    lines: Vec<(Vec<[f32; 2]>, Option<u32>)>,
 }
 
 impl Tally {
@@ -667,7 +728,15 @@ fn measure(tile: &Tile, params: KernelParams) -> Tally {
         t.steps.push(slab.step_m);
         t.spacings.push(slab.spacing_m);
         t.points.push(slab.u.len() as f64);
-        let (outcome, rho) = run_kernel(&mut kernel, &mut line, &slab);
+        let (outcome, rho, left) = run_kernel(&mut kernel, &mut line, &slab);
+        t.lines.push((
+            slab.u
+                .iter()
+                .zip(&slab.z)
+                .map(|(&u, &z)| [(u - slab.u_s) as f32, (z - slab.z_s) as f32])
+                .collect(),
+            left,
+        ));
         if rho.is_finite() {
             t.rho_near.push(f64::from(rho));
         }
@@ -805,6 +874,15 @@ fn kernel_finds_real_curbs_on_virtual_scanlines() {
         "the cut must yield enough slabs: {}",
         t.slabs
     );
+    // The on-board path (wire packets → ring → assembly → kernel, as the firmware runs it)
+    // gives the same candidate on every line as `Kernel::process` called directly.
+    let lines: Vec<Vec<[f32; 2]>> = t.lines.iter().map(|l| l.0.clone()).collect();
+    let direct: Vec<Option<u32>> = t.lines.iter().map(|l| l.1).collect();
+    assert_eq!(
+        pipeline_left_tags(&lines),
+        direct,
+        "Pipeline against Kernel"
+    );
     assert!(
         t.rate(t.within_01) >= 0.10,
         "within 0.1 m: {} of {}",
@@ -831,4 +909,168 @@ fn kernel_finds_real_curbs_on_virtual_scanlines() {
     let mut steps = t.steps.clone();
     let step = median(&mut steps).unwrap();
     assert!((0.03..0.08).contains(&step), "median step {step} m");
+}
+
+// ---------------------------------------------------------------------------------------
+// 4. KITTI: the kernel on real single sweeps (one ring of an HDL-64E)
+// ---------------------------------------------------------------------------------------
+
+/// The four KITTI frames (drive 2011_10_03_0042).
+const KITTI: [&str; 4] = [
+    "0000000280.bin",
+    "0000000428.bin",
+    "0000000917.bin",
+    "0000000918.bin",
+];
+
+/// One frame as rings: each ring is one revolution of one laser, in acquisition order.
+/// The frames store the points ring by ring, and within a ring the azimuth atan2(y, x)
+/// increases from −180° (behind) through −90° (right), 0° (ahead) and +90° (left), so a
+/// ring ends where the azimuth wraps from about +180° back to −180°.
+fn kitti_rings(path: &Path) -> Vec<Vec<[f32; 3]>> {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert_eq!(
+        bytes.len() % 16,
+        0,
+        "{}: x, y, z, reflectance as f32",
+        path.display()
+    );
+    let mut rings: Vec<Vec<[f32; 3]>> = vec![Vec::new()];
+    let mut last_az = f32::NAN;
+    for rec in bytes.chunks_exact(16) {
+        let f = |k: usize| {
+            f32::from_le_bytes([rec[4 * k], rec[4 * k + 1], rec[4 * k + 2], rec[4 * k + 3]])
+        };
+        let p = [f(0), f(1), f(2)];
+        let az = p[1].atan2(p[0]).to_degrees();
+        if last_az - az > 180.0 {
+            rings.push(Vec::new());
+        }
+        last_az = az;
+        rings.last_mut().unwrap().push(p);
+    }
+    rings
+}
+
+/// Per frame and side: the candidate (x, y) of every ring that sees the road ahead.
+#[derive(Debug, Default)]
+struct RingTally {
+    rings: usize,
+    lines_run: usize,
+    candidates: [Vec<[f64; 2]>; 2],
+    /// Height step across each candidate (outer side minus road side, 0.1–0.5 m off; NaN
+    /// where one side has no point).
+    steps: [Vec<f64>; 2],
+}
+
+/// The most candidates within `tol` of one straight line through two of them at least 1 m
+/// apart, and that line as (lateral offset at x = 0, slope dy/dx).
+fn best_line(c: &[[f64; 2]], tol: f64) -> (usize, f64, f64) {
+    let mut best = (0, f64::NAN, f64::NAN);
+    for i in 0..c.len() {
+        for j in i + 1..c.len() {
+            let (dx, dy) = (c[j][0] - c[i][0], c[j][1] - c[i][1]);
+            let len = dx.hypot(dy);
+            if len < 1.0 {
+                continue;
+            }
+            let n = c
+                .iter()
+                .filter(|p| ((p[0] - c[i][0]) * dy - (p[1] - c[i][1]) * dx).abs() / len <= tol)
+                .count();
+            if n > best.0 && dx.abs() > 1e-9 {
+                let slope = dy / dx;
+                best = (n, c[i][1] - slope * c[i][0], slope);
+            }
+        }
+    }
+    best
+}
+
+/// Runs the kernel on the front half of every ring of a frame (azimuth −90°…+90°, right to
+/// left, as a profiler sweeps below itself): x′ = y (left positive), z′ = z (the sensor is
+/// the origin, about 1.73 m above the road).
+fn kitti_frame(path: &Path, params: KernelParams) -> RingTally {
+    let rings = kitti_rings(path);
+    let mut kernel = Box::new(Kernel::<N>::new(params));
+    kernel.set_params(params).expect("valid parameters");
+    let mut line = Box::new(Line::<N>::new());
+    let mut t = RingTally {
+        rings: rings.len(),
+        ..RingTally::default()
+    };
+    for ring in &rings {
+        let front: Vec<[f32; 3]> = ring.iter().copied().filter(|p| p[0] > 0.0).collect();
+        // Only rings that see the road ahead (the points within 1 m of the car's axis lie
+        // more than 1.2 m below the sensor): the upper lasers see facades and trees.
+        let mut ahead: Vec<f64> = front
+            .iter()
+            .filter(|p| p[1].abs() < 1.0)
+            .map(|p| f64::from(p[2]))
+            .collect();
+        if front.len() < 10 || median(&mut ahead).is_none_or(|z| z > -1.2) {
+            continue;
+        }
+        line.clear();
+        for (k, p) in front.iter().enumerate() {
+            let _ = line.push(p[1], p[2], k as u32);
+        }
+        t.lines_run += 1;
+        let out = kernel.process(&mut line);
+        for (side, cand) in [out.left, out.right].into_iter().enumerate() {
+            let Some(i) = cand else { continue };
+            let p = front[out.tag[usize::from(i)] as usize];
+            let (cy, sign) = (f64::from(p[1]), if side == 0 { 1.0 } else { -1.0 });
+            let band = |lo: f64, hi: f64| {
+                let mut v: Vec<f64> = front
+                    .iter()
+                    .filter(|q| {
+                        let o = sign * (f64::from(q[1]) - cy);
+                        o >= lo && o < hi
+                    })
+                    .map(|q| f64::from(q[2]))
+                    .collect();
+                median(&mut v)
+            };
+            let step = match (band(0.1, 0.5), band(-0.5, -0.1)) {
+                (Some(a), Some(b)) => a - b,
+                _ => f64::NAN,
+            };
+            t.steps[side].push(step);
+            t.candidates[side].push([f64::from(p[0]), cy]);
+        }
+    }
+    t
+}
+
+/// Prints the KITTI measurement of `docs/real-data.md`.
+#[test]
+#[ignore = "prints the KITTI measurement of docs/real-data.md"]
+fn kitti_ring_report() {
+    let Some(dir) = data("kitti_lrbd", "kitti_ring_report") else {
+        return;
+    };
+    for f in KITTI {
+        for (what, p) in variants().into_iter().take(1) {
+            let t = kitti_frame(&dir.join(f), p);
+            println!("{f} {what}: {} rings, {} lines", t.rings, t.lines_run);
+            for (side, name) in [(0, "left"), (1, "right")] {
+                let c = &t.candidates[side];
+                let (n1, a1, b1) = best_line(c, 0.1);
+                let (n2, _, _) = best_line(c, 0.2);
+                let on_line: Vec<f64> = c
+                    .iter()
+                    .zip(&t.steps[side])
+                    .filter(|(p, st)| {
+                        st.is_finite() && (p[1] - a1 - b1 * p[0]).abs() / b1.hypot(1.0) <= 0.1
+                    })
+                    .map(|(_, &st)| st)
+                    .collect();
+                println!(
+                    "  {name:<5}: {} candidates, {} within 0.1 m of one line (y = {a1:.2} + {b1:.3} x), {} within 0.2 m; step on the line q25/50/75 {}",
+                    c.len(), n1, n2, quantiles(&on_line)
+                );
+            }
+        }
+    }
 }
