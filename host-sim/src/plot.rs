@@ -60,6 +60,20 @@ fn draw_err<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> PlotError + '_ {
     }
 }
 
+/// The legend box every chart here uses: white, half-transparent, thin black border.
+fn draw_legend<'a, DB: DrawingBackend + 'a, CT: plotters::coord::CoordTranslate>(
+    ch: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    font_px: u32,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    ch.configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK.mix(0.5))
+        .label_font((FONT_NAME, font_px))
+        .draw()
+}
+
 fn input_err(path: &Path, what: impl Into<String>) -> PlotError {
     PlotError::Input {
         path: path.display().to_string(),
@@ -782,14 +796,7 @@ pub fn top_view_png(path: &Path, view: &TopView) -> Result<TopViewStats, PlotErr
             .label("trajectory")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 10, y)], traj_style));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.5))
-        .label_font((FONT_NAME, 16))
-        .draw()
-        .map_err(&err)?;
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 16).map_err(&err)?;
 
     let bar_title = match view.colouring {
         Colouring::Height => "height [m]",
@@ -1082,13 +1089,7 @@ pub fn cross_section_png(path: &Path, cs: &CrossSection) -> Result<(), PlotError
         .label("seed candidate")
         .legend(move |(x, y)| Circle::new((x + 10, y), 6, red.stroke_width(3)));
     }
-    ch.configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.5))
-        .label_font((FONT_NAME, 15))
-        .draw()
-        .map_err(&err)?;
+    draw_legend(&mut ch, SeriesLabelPosition::UpperLeft, 15).map_err(&err)?;
 
     // Bend angles.
     let mut ch = ChartBuilder::on(&bottom)
@@ -1164,13 +1165,7 @@ pub fn cross_section_png(path: &Path, cs: &CrossSection) -> Result<(), PlotError
         .label("seed candidate")
         .legend(move |(x, y)| Circle::new((x + 10, y), 6, red.stroke_width(3)));
     }
-    ch.configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.5))
-        .label_font((FONT_NAME, 15))
-        .draw()
-        .map_err(&err)?;
+    draw_legend(&mut ch, SeriesLabelPosition::UpperLeft, 15).map_err(&err)?;
     root.present().map_err(&err)?;
     Ok(())
 }

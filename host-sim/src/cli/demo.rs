@@ -227,15 +227,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let profile = scanline_profile(&sim, &cfg.kernel.to_params());
 
     // 4. Evaluate, draw, report.
-    let x: Vec<f64> = sim.returns.iter().map(|r| r.p[0] + origin[0]).collect();
-    let y: Vec<f64> = sim.returns.iter().map(|r| r.p[1] + origin[1]).collect();
-    let z: Vec<f64> = sim.returns.iter().map(|r| r.p[2] + origin[2]).collect();
-    let traj: Vec<[f64; 2]> = sim
-        .traj
-        .samples
-        .iter()
-        .map(|p| [p.x + origin[0], p.y + origin[1]])
-        .collect();
+    let [x, y, z] = sim.world_columns();
+    let traj = sim.world_trajectory_xy();
     let cross_section = profile.as_ref().map(|p| CrossSection {
         title: format!(
             "scanline {} of {} ({} points): bend angles before and after Taubin smoothing",

@@ -468,16 +468,8 @@ mod tests {
         let t = Instant::now();
         let sim = simulate(&spec, 1, None, false).unwrap();
         let sim_s = t.elapsed().as_secs_f64();
-        let o = sim.world.spec.origin;
-        let x: Vec<f64> = sim.returns.iter().map(|r| r.p[0] + o[0]).collect();
-        let y: Vec<f64> = sim.returns.iter().map(|r| r.p[1] + o[1]).collect();
-        let z: Vec<f64> = sim.returns.iter().map(|r| r.p[2] + o[2]).collect();
-        let traj: Vec<[f64; 2]> = sim
-            .traj
-            .samples
-            .iter()
-            .map(|p| [p.x + o[0], p.y + o[1]])
-            .collect();
+        let [x, y, z] = sim.world_columns();
+        let traj = sim.world_trajectory_xy();
         let ext: Vec<EdgeLine> = sim
             .reference
             .iter()

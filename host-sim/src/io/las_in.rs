@@ -362,6 +362,68 @@ fn check_evlrs(path: &Path, file: &mut File, head: &[u8], file_size: u64) -> Res
     Ok(())
 }
 
+/// LAZ: the chunk table's entry count, checked against the compressed bytes before the
+/// `laz` crate reserves a `Vec` of that many 16-byte entries (fuzz target `host_inputs`
+/// found a 2^32-entry claim: a 60 GB allocation). Every chunk takes at least one byte
+/// between the point data start (plus its 8-byte table offset) and the table, so more
+/// entries than those bytes cannot be true. Locating the table mirrors
+/// `laz::laszip::ChunkTable::read_offset`: the offset at the start of the point data, or,
+/// when the writer could not update it, in the file's last 8 bytes.
+fn check_laz_chunk_table(
+    path: &Path,
+    file: &mut File,
+    head: &RawHead,
+    file_size: u64,
+) -> Result<(), LasError> {
+    use std::io::{Seek, SeekFrom};
+    if !head.compressed {
+        return Ok(());
+    }
+    let io = |source| LasError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let bad = |what: String| LasError::Truncated {
+        path: path.to_path_buf(),
+        what,
+    };
+    let read_u64_at = |file: &mut File, pos: u64| -> Result<u64, LasError> {
+        let mut b = [0u8; 8];
+        file.seek(SeekFrom::Start(pos))
+            .and_then(|_| file.read_exact(&mut b))
+            .map_err(io)?;
+        Ok(u64::from_le_bytes(b))
+    };
+    let data_start = u64::from(head.offset_to_point_data);
+    if data_start.saturating_add(8) > file_size || file_size < 16 {
+        // No room for the table offset: the `laz` crate reports the short read itself.
+        return Ok(());
+    }
+    let mut table = read_u64_at(file, data_start)? as i64;
+    if table <= data_start as i64 {
+        table = read_u64_at(file, file_size - 8)? as i64;
+        if table <= data_start as i64 {
+            file.seek(SeekFrom::Start(0)).map_err(io)?;
+            return Ok(()); // no chunk table: `laz` reports it missing
+        }
+    }
+    let table = table as u64;
+    if table.saturating_add(8) > file_size {
+        return Err(bad(format!(
+            "the LAZ chunk table would start at byte {table}, past the end of the {file_size}-byte file"
+        )));
+    }
+    let chunks = read_u64_at(file, table)? >> 32;
+    let room = table.saturating_sub(data_start + 8);
+    if chunks > room {
+        return Err(bad(format!(
+            "the LAZ chunk table claims {chunks} chunks but only {room} bytes of compressed points precede it"
+        )));
+    }
+    file.seek(SeekFrom::Start(0)).map_err(io)?;
+    Ok(())
+}
+
 fn parse_raw_head(path: &Path, bytes: &[u8], file_size: u64) -> Result<RawHead, LasError> {
     let path = path.to_path_buf();
     if file_size == 0 {
@@ -462,6 +524,7 @@ pub fn read_points(
         .map_err(io)?;
     let head = parse_raw_head(path, &head_bytes, file_size)?;
     check_evlrs(path, &mut file, &head_bytes, file_size)?;
+    check_laz_chunk_table(path, &mut file, &head, file_size)?;
     if !format_has_gps_time(head.format) {
         return Err(LasError::NoGpsTime {
             path: path.to_path_buf(),
@@ -852,6 +915,37 @@ pub(crate) mod tests {
 
     fn read(path: &Path, scanner: Option<u16>) -> Result<(PointColumns, LasInfo), LasError> {
         read_points(path, &ReadOptions { scanner }, &mut |_, _| {})
+    }
+
+    /// Regression (fuzz target `host_inputs`, session 2): a LAZ chunk table claiming 2^32
+    /// chunks made the `laz` crate reserve 60 GB before decoding a single entry.
+    #[test]
+    fn a_laz_chunk_table_claiming_more_chunks_than_bytes_is_an_error_before_any_allocation() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("chunks.laz");
+        let pts: Vec<Point> = (0..10)
+            .map(|i| pt(500_000.0 + i as f64, 4_000_000.0, 0.0, i as f64))
+            .collect();
+        write_las(&path, 6, &pts, None);
+        let good = std::fs::read(&path).unwrap();
+        assert_eq!(read(&path, None).unwrap().0.t.len(), 10);
+        let data_start = u32::from_le_bytes(good[96..100].try_into().unwrap()) as usize;
+        let table = u64::from_le_bytes(good[data_start..data_start + 8].try_into().unwrap());
+        let table = usize::try_from(table).unwrap();
+        let mut bytes = good.clone();
+        bytes[table + 4..table + 8].copy_from_slice(&u32::MAX.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let err = read(&path, None).unwrap_err().to_string();
+        assert!(
+            err.contains("chunks.laz") && err.contains("chunk table claims 4294967295 chunks"),
+            "{err}"
+        );
+        // A table offset past the end of the file.
+        let mut bytes = good.clone();
+        bytes[data_start..data_start + 8].copy_from_slice(&(1u64 << 40).to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let err = read(&path, None).unwrap_err().to_string();
+        assert!(err.contains("past the end"), "{err}");
     }
 
     /// Regression (fuzz target `host_inputs`): an EVLR whose 64-bit length exceeds the file

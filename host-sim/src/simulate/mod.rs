@@ -110,6 +110,25 @@ pub struct Simulation {
     pub scan: (f64, f64),
 }
 
+impl Simulation {
+    /// The returns' world coordinates (the scene origin added back), as x, y, z columns.
+    pub fn world_columns(&self) -> [Vec<f64>; 3] {
+        let o = self.world.spec.origin;
+        let col = |k: usize| self.returns.iter().map(|r| r.p[k] + o[k]).collect();
+        [col(0), col(1), col(2)]
+    }
+
+    /// The trajectory's world x, y (the scene origin added back).
+    pub fn world_trajectory_xy(&self) -> Vec<[f64; 2]> {
+        let o = self.world.spec.origin;
+        self.traj
+            .samples
+            .iter()
+            .map(|p| [p.x + o[0], p.y + o[1]])
+            .collect()
+    }
+}
+
 /// What a run produced.
 #[derive(Clone, Debug)]
 pub struct SimSummary {
