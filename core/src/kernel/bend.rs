@@ -207,6 +207,7 @@ pub const MAX_COORD_M: f32 = 2000.0;
 ///
 /// No atan2: with φ = atan2(|c|, d) ∈ [0, π] and θ the threshold, φ > θ ⟺ sin(φ − θ) > 0
 /// ⟺ |c|·cos θ − d·sin θ > 0 (both sides scaled by |a||b| > 0).
+#[inline(never)] // its own registers: inlined into `process`, it rematerialised addresses
 pub(crate) fn mark_irregular(
     x: &[f32],
     z: &[f32],
@@ -218,27 +219,30 @@ pub(crate) fn mark_irregular(
     let n = x.len();
     let (z, s_off, t_off, status) = (&z[..n], &s_off[..n], &t_off[..n], &mut status[..n]);
     let (mut irregular, mut non_finite) = (0u32, 0u32);
-    for i in 0..n {
-        let s = i - usize::from(s_off[i]);
-        let t = i + usize::from(t_off[i]);
+    // Iterators rather than indices for the per-point arrays: each gets its own pointer
+    // (on the M4F, indexing them from one base rematerialised large offsets every point).
+    let per_point = status.iter_mut().zip(s_off.iter().zip(t_off));
+    for (i, (st, (&so, &to))) in per_point.enumerate() {
         let (xi, zi) = (x[i], z[i]);
         // Out of range counts as non-finite: the wire carries any finite f32, but squares of
         // coordinates near f32::MAX overflow in the bend angle and in smoothing (found by the
         // `kernel_points` fuzz target), and output packets hold |x′|, |z′| < 2147 m.
-        // `contains` is false for NaN and ±inf.
-        if !((-MAX_COORD_M..=MAX_COORD_M).contains(&xi)
-            && (-MAX_COORD_M..=MAX_COORD_M).contains(&zi))
-        {
-            status[i] = PointStatus::NonFinite;
+        // |v| ≤ MAX_COORD_M compared on the bit patterns of |x′| and |z′| (monotone for
+        // non-negative floats; NaN and ±inf lie above): the same test as
+        // `(-MAX..=MAX).contains(&v)` on both, in integer instructions.
+        let mag = (xi.to_bits() & 0x7FFF_FFFF).max(zi.to_bits() & 0x7FFF_FFFF);
+        if mag > MAX_COORD_BITS {
+            *st = PointStatus::NonFinite;
             non_finite += 1;
             continue;
         }
+        let (so, to) = (usize::from(so), usize::from(to));
         // An isolated point (nothing within d_b on either side: a spike taller than d_b)
         // is judged by its adjacent points instead, or it could never be removed.
-        let (sj, tj) = if s == i && t == i && i > 0 && i + 1 < n {
+        let (sj, tj) = if so == 0 && to == 0 && i > 0 && i + 1 < n {
             (i - 1, i + 1)
         } else {
-            (s, t)
+            (i - so, i + to)
         };
         let (ax, az) = (xi - x[sj], zi - z[sj]);
         let (bx, bz) = (x[tj] - xi, z[tj] - zi);
@@ -246,14 +250,18 @@ pub(crate) fn mark_irregular(
         let d = ax * bx + az * bz;
         // With s == i or t == i, c = d = 0 and the test is false: kept.
         if math::abs(c) * thr.cos - d * thr.sin > 0.0 {
-            status[i] = PointStatus::Irregular;
+            *st = PointStatus::Irregular;
             irregular += 1;
         } else {
-            status[i] = PointStatus::Kept;
+            *st = PointStatus::Kept;
         }
     }
     (irregular, non_finite)
 }
+
+/// Bit pattern of [`MAX_COORD_M`].
+const MAX_COORD_BITS: u32 = 0x44FA_0000;
+const _: () = assert!(MAX_COORD_M.to_bits() == MAX_COORD_BITS);
 
 /// The signed bend angle at `i` with neighbours `s` and `t`, degrees in (−180, 180]
 /// (SPEC §2 sign rule; see the module docs).
@@ -293,6 +301,7 @@ pub(crate) fn bend_angle_deg<M: Backend>(
 
 /// ρ on the (smoothed) line for every point, with the offsets from [`windows`]; 0 where a
 /// side has no neighbour.
+#[inline(never)] // its own registers (see `mark_irregular`)
 pub(crate) fn bend_angles<M: Backend>(
     x: &[f32],
     z: &[f32],
