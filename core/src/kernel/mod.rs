@@ -223,9 +223,18 @@ impl<const N: usize> Kernel<N> {
         let kept = n - (irr + non_finite) as usize;
 
         // 2. Kept points to the front, in order.
+        // Points before the first set-aside one stay where they are.
+        let first_out = if kept < n {
+            status
+                .iter()
+                .position(|st| *st != PointStatus::Kept)
+                .unwrap_or(n)
+        } else {
+            n
+        };
         if kept < n {
-            let mut w = 0;
-            for (i, st) in status.iter().enumerate() {
+            let mut w = first_out;
+            for (i, st) in status.iter().enumerate().skip(first_out + 1) {
                 if *st == PointStatus::Kept {
                     x.swap(w, i);
                     z.swap(w, i);
@@ -275,9 +284,10 @@ impl<const N: usize> Kernel<N> {
                 *st = status_of(a);
             }
         } else {
+            // Points before `first_out` never moved (w = i there).
             let mut w = kept;
             let mut map = idx;
-            for i in (0..n).rev() {
+            for i in (first_out..n).rev() {
                 if status[i] == PointStatus::Kept {
                     w -= 1;
                     x.swap(w, i);
@@ -290,6 +300,9 @@ impl<const N: usize> Kernel<N> {
                         }
                     }
                 }
+            }
+            for (st, &a) in status[..first_out].iter_mut().zip(aux.iter()) {
+                *st = status_of(a);
             }
             idx = map;
         }

@@ -278,16 +278,20 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
 
     fn step(&mut self) -> Step {
         if let Some(mut cur) = self.cur {
+            // The ring does not change while its records are assembled: split it once.
+            // `points_in` counts every record taken off (`cur.next` advanced), added up
+            // once at the end of the loop rather than per point.
+            let (a, b) = self.ring.as_slices();
+            let first = cur.next;
             while cur.next < cur.count {
                 let at = HEADER_LEN + POINTS_PREFIX_LEN + cur.next * POINT_RECORD_LEN;
                 // Parse in place when the record is contiguous; copy it out only when it
                 // straddles the ring's seam. The scanner checked the packet is all there.
-                let (a, _) = self.ring.as_slices();
                 let parsed = match a.get(at..at + POINT_RECORD_LEN) {
                     Some(rec) => PointRecord::parse(rec),
                     None => {
                         let mut rec = [0u8; POINT_RECORD_LEN];
-                        let _ = self.ring.peek(at, &mut rec);
+                        let _ = crate::wire::copy_from_two(a, b, at, &mut rec);
                         PointRecord::parse(&rec)
                     }
                 };
@@ -295,7 +299,6 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
                     Ok(p) => p,
                     Err(e) => {
                         cur.next += 1;
-                        self.c.points_in += 1;
                         match e {
                             WireError::NonFinite { .. } => self.c.points_non_finite += 1,
                             _ => self.c.points_reserved_flags += 1,
@@ -305,21 +308,19 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
                 };
                 let Some(t) = cur.base_time_ns.checked_add(u64::from(p.dt_ns)) else {
                     cur.next += 1;
-                    self.c.points_in += 1;
                     self.c.points_time_overflow += 1;
                     continue;
                 };
                 match self.asm.offer(t, &p) {
-                    Offer::Taken => {
-                        cur.next += 1;
-                        self.c.points_in += 1;
-                    }
+                    Offer::Taken => cur.next += 1,
                     Offer::Split(_) => {
+                        self.c.points_in += (cur.next - first) as u64;
                         self.cur = Some(cur);
                         return Step::Line;
                     }
                 }
             }
+            self.c.points_in += (cur.next - first) as u64;
             self.ring.consume(cur.len);
             self.c.bytes_packets += cur.len as u64;
             self.cur = None;
