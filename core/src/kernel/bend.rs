@@ -181,6 +181,9 @@ pub(crate) struct Threshold {
 }
 
 impl Threshold {
+    /// A placeholder before the parameters' threshold is computed.
+    pub(crate) const PENDING: Self = Self { cos: 0.0, sin: 0.0 };
+
     /// The threshold `deg` degrees (0 < deg ≤ 180).
     pub(crate) fn new(deg: f32) -> Self {
         let r = deg / RAD_TO_DEG;

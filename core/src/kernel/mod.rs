@@ -133,6 +133,12 @@ struct Derived {
 }
 
 impl Derived {
+    /// Stands in until [`Derived::new`] has run (never used for a line).
+    const PENDING: Self = Self {
+        d2: 0.0,
+        irregular: bend::Threshold::PENDING,
+    };
+
     fn new(p: &KernelParams) -> Self {
         Self {
             d2: p.d_b_m * p.d_b_m,
@@ -157,21 +163,30 @@ pub struct Kernel<const N: usize> {
     s_off: [u8; N],
     /// The peak search's window-maximum deque.
     deque: [u16; seed::DEQUE_LEN],
+    /// `params_hash` and `derived` are still to be computed from `params` (a kernel made
+    /// by the `const` [`Kernel::new`] computes them on its first line).
+    fresh: bool,
 }
 
 impl<const N: usize> Kernel<N> {
     /// A kernel running `params` (taken as they are; [`Kernel::set_params`] checks them).
-    pub fn new(params: KernelParams) -> Self {
+    ///
+    /// `const`, so that a kernel can be a `static` (on the firmware, built in place rather
+    /// than passed through a small stack): the values derived from the parameters (their
+    /// hash, the irregular threshold's cosine and sine — libm is not `const`) are computed
+    /// when the first line is processed.
+    pub const fn new(params: KernelParams) -> Self {
         const { assert!(N <= u16::MAX as usize, "Kernel<N>: N must fit a u16 index") };
         Self {
-            params_hash: params.hash(),
-            derived: Derived::new(&params),
+            params_hash: 0,
+            derived: Derived::PENDING,
             params,
             rho: [0.0; N],
             status: [PointStatus::Kept; N],
             aux: [0; N],
             s_off: [0; N],
             deque: [0; seed::DEQUE_LEN],
+            fresh: true,
         }
     }
 
@@ -186,6 +201,7 @@ impl<const N: usize> Kernel<N> {
         self.params = params;
         self.params_hash = params.hash();
         self.derived = Derived::new(&params);
+        self.fresh = false;
         Ok(())
     }
 
@@ -201,6 +217,11 @@ impl<const N: usize> Kernel<N> {
         &'a mut self,
         line: &'a mut Line<N>,
     ) -> ScanlineOutput<'a> {
+        if self.fresh {
+            self.params_hash = self.params.hash();
+            self.derived = Derived::new(&self.params);
+            self.fresh = false;
+        }
         let n = line.len.min(N);
         let p = self.params;
         let Derived { d2, irregular } = self.derived;

@@ -117,6 +117,45 @@ pub struct IngestCounters {
     pub split_end: u64,
 }
 
+impl IngestCounters {
+    /// All zero (`const`, unlike `Default::default`).
+    pub const ZERO: Self = IngestCounters {
+        bytes_in: 0,
+        bytes_dropped_full: 0,
+        bytes_garbage: 0,
+        bytes_rejected: 0,
+        bytes_packets: 0,
+        bytes_buffered: 0,
+        crc_errors: 0,
+        bad_length: 0,
+        cut_at_end: 0,
+        bad_version: 0,
+        bad_kind: 0,
+        bad_kind_length: 0,
+        reserved_flags: 0,
+        output_ignored: 0,
+        packets_points: 0,
+        packets_config: 0,
+        seq_gaps: 0,
+        packets_missing: 0,
+        points_in: 0,
+        points_non_finite: 0,
+        points_reserved_flags: 0,
+        points_time_overflow: 0,
+        points_pending: 0,
+        points_in_lines: 0,
+        points_truncated: 0,
+        lines: 0,
+        lines_truncated: 0,
+        split_line_start: 0,
+        split_zenith: 0,
+        split_time_gap: 0,
+        split_seq_gap: 0,
+        split_config: 0,
+        split_end: 0,
+    };
+}
+
 /// The points packet being read at the front of the ring.
 #[derive(Clone, Copy, Debug)]
 struct Current {
@@ -161,41 +200,7 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
             pending_config: None,
             next_seq: None,
             finishing: false,
-            c: IngestCounters {
-                bytes_in: 0,
-                bytes_dropped_full: 0,
-                bytes_garbage: 0,
-                bytes_rejected: 0,
-                bytes_packets: 0,
-                bytes_buffered: 0,
-                crc_errors: 0,
-                bad_length: 0,
-                cut_at_end: 0,
-                bad_version: 0,
-                bad_kind: 0,
-                bad_kind_length: 0,
-                reserved_flags: 0,
-                output_ignored: 0,
-                packets_points: 0,
-                packets_config: 0,
-                seq_gaps: 0,
-                packets_missing: 0,
-                points_in: 0,
-                points_non_finite: 0,
-                points_reserved_flags: 0,
-                points_time_overflow: 0,
-                points_pending: 0,
-                points_in_lines: 0,
-                points_truncated: 0,
-                lines: 0,
-                lines_truncated: 0,
-                split_line_start: 0,
-                split_zenith: 0,
-                split_time_gap: 0,
-                split_seq_gap: 0,
-                split_config: 0,
-                split_end: 0,
-            },
+            c: IngestCounters::ZERO,
         }
     }
 
