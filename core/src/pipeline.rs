@@ -326,7 +326,10 @@ mod tests {
         p.finish(|o| hashes.push((o.params_hash, o.left)));
         assert_eq!(hashes, [(KernelParams::DEFAULT.hash(), Some(200)); 2]);
         // The split rules in force are the parameters', applied before the first point.
-        assert_eq!(p.ingest.split_params(), KernelParams::DEFAULT.split_params());
+        assert_eq!(
+            p.ingest.split_params(),
+            KernelParams::DEFAULT.split_params()
+        );
     }
 
     #[test]

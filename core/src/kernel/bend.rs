@@ -86,12 +86,16 @@ fn windows_sweeps(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8], t_off: &mut [
             let (dx, dz) = (x[j] - xi, z[j] - zi);
             !(dx * dx + dz * dz <= d2)
         };
-        s = s.max(i.saturating_sub(MAX_SIDE));
+        // s ≤ i: max(s, i − MAX_SIDE) without the saturating subtraction.
+        if i - s > MAX_SIDE {
+            s = i - MAX_SIDE;
+        }
         while s < i && far(s) {
             s += 1;
         }
-        s_off[i] = (i - s) as u8;
-        if s + MAX_SIDE == i && s > 0 && !far(s - 1) {
+        let off = i - s;
+        s_off[i] = off as u8;
+        if off == MAX_SIDE && s > 0 && !far(s - 1) {
             capped += 1;
         }
     }
@@ -103,9 +107,9 @@ fn windows_sweeps(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8], t_off: &mut [
             let (dx, dz) = (x[k] - xj, z[k] - zj);
             !(dx * dx + dz * dz <= d2)
         };
-        let hi = j + MAX_SIDE;
-        if t > hi {
-            t = hi;
+        // j ≤ t: min(t, j + MAX_SIDE) as a comparison of the offset.
+        if t - j > MAX_SIDE {
+            t = j + MAX_SIDE;
             if !far(t + 1) {
                 capped += 1;
             }

@@ -28,6 +28,9 @@
 /// single-precision registers.
 pub(crate) const GROUP: usize = 4;
 
+/// A larger group, tried first.
+pub(crate) const BIG_GROUP: usize = 8;
+
 /// One step's coefficients: p ← keep·p + half·(p₋ + p₊), keep = 1 − a, half = a/2.
 #[derive(Clone, Copy, Debug)]
 struct Coef {
@@ -123,10 +126,17 @@ fn smooth_piece_fused(v: &mut [f32], steps: u32, lambda: Coef, mu: Coef) {
         return;
     }
     let mut k = 0;
+    if n >= BIG_GROUP + 2 {
+        let co: [Coef; BIG_GROUP] = core::array::from_fn(|s| coef(s as u32, lambda, mu));
+        while k + BIG_GROUP as u32 <= steps {
+            fused_group::<BIG_GROUP>(v, &co);
+            k += BIG_GROUP as u32;
+        }
+    }
     if n >= GROUP + 2 {
         let co: [Coef; GROUP] = core::array::from_fn(|s| coef(s as u32, lambda, mu));
         while k + GROUP as u32 <= steps {
-            fused_group(v, &co);
+            fused_group::<GROUP>(v, &co);
             k += GROUP as u32;
         }
     }
@@ -142,9 +152,9 @@ fn smooth_piece_fused(v: &mut [f32], steps: u32, lambda: Coef, mu: Coef) {
 /// the last step's value at t − [`GROUP`]. Rotating the three slots instead of shifting
 /// values saves a register move per step and point once the caller unrolls by 3.
 #[inline(always)]
-fn tick<const P: usize>(w: &mut [[f32; 3]; GROUP], co: &[Coef; GROUP], x: f32) -> f32 {
+fn tick<const P: usize, const K: usize>(w: &mut [[f32; 3]; K], co: &[Coef; K], x: f32) -> f32 {
     let mut x = x;
-    for s in 0..GROUP {
+    for s in 0..K {
         let (a, b) = (w[s][P], w[s][(P + 1) % 3]);
         w[s][(P + 2) % 3] = x;
         x = co[s].apply(a, b, x);
@@ -154,67 +164,69 @@ fn tick<const P: usize>(w: &mut [[f32; 3]; GROUP], co: &[Coef; GROUP], x: f32) -
 
 /// The (older, newer) values of every step after ticks ending at phase `P`.
 #[inline(always)]
-fn state<const P: usize>(w: &[[f32; 3]; GROUP]) -> [[f32; 2]; GROUP] {
+fn state<const P: usize, const K: usize>(w: &[[f32; 3]; K]) -> [[f32; 2]; K] {
     core::array::from_fn(|s| [w[s][P], w[s][(P + 1) % 3]])
 }
 
 /// [`GROUP`] steps with coefficients `co` over `v` in place, in one pass (`v.len()` ≥
 /// [`GROUP`] + 2). Step s's value at point m is computed exactly as [`step`] computes it,
 /// from step s − 1's values at m − 1, m, m + 1; only the order differs.
-fn fused_group(v: &mut [f32], co: &[Coef; GROUP]) {
+fn fused_group<const K: usize>(v: &mut [f32], co: &[Coef; K]) {
     let n = v.len();
-    debug_assert!(n >= GROUP + 2);
+    debug_assert!(n >= K + 2);
     // Start: before input point GROUP + 1, step s (0 = the input) must hold its values at
     // GROUP − s − 1 and GROUP − s. Step s's value at m depends on the input up to m + s,
-    // so s steps over the first GROUP + 2 points alone (right end held) are exact there.
-    let mut head = [0f32; GROUP + 2];
-    head.copy_from_slice(&v[..GROUP + 2]);
-    let mut st = [[0f32; 2]; GROUP];
-    for s in 0..GROUP {
+    // so s steps over the first K + 2 points alone (right end held) are exact there.
+    const { assert!(K <= BIG_GROUP) };
+    let mut head_buf = [0f32; BIG_GROUP + 2];
+    let head = &mut head_buf[..K + 2];
+    head.copy_from_slice(&v[..K + 2]);
+    let mut st = [[0f32; 2]; K];
+    for s in 0..K {
         if s > 0 {
-            step_in_place(&mut head, co[s - 1]);
+            step_in_place(head, co[s - 1]);
         }
-        st[s] = [head[GROUP - s - 1], head[GROUP - s]];
+        st[s] = [head[K - s - 1], head[K - s]];
     }
-    let mut w: [[f32; 3]; GROUP] = core::array::from_fn(|s| [st[s][0], st[s][1], 0.0]);
+    let mut w: [[f32; 3]; K] = core::array::from_fn(|s| [st[s][0], st[s][1], 0.0]);
 
     // The wavefront over input points GROUP + 1 ..= n − 1: every step computes an interior
     // value (t − s − 1 ∈ 1..=n − 2) and the last one is stored at t − GROUP ≥ 1, behind
     // every point still to be read.
-    let mut t = GROUP + 1;
+    let mut t = K + 1;
     while t + 2 < n {
-        v[t - GROUP] = tick::<0>(&mut w, co, v[t]);
-        v[t + 1 - GROUP] = tick::<1>(&mut w, co, v[t + 1]);
-        v[t + 2 - GROUP] = tick::<2>(&mut w, co, v[t + 2]);
+        v[t - K] = tick::<0, K>(&mut w, co, v[t]);
+        v[t + 1 - K] = tick::<1, K>(&mut w, co, v[t + 1]);
+        v[t + 2 - K] = tick::<2, K>(&mut w, co, v[t + 2]);
         t += 3;
     }
     let st = if t < n {
-        v[t - GROUP] = tick::<0>(&mut w, co, v[t]);
+        v[t - K] = tick::<0, K>(&mut w, co, v[t]);
         t += 1;
         if t < n {
-            v[t - GROUP] = tick::<1>(&mut w, co, v[t]);
-            state::<2>(&w)
+            v[t - K] = tick::<1, K>(&mut w, co, v[t]);
+            state::<2, K>(&w)
         } else {
-            state::<1>(&w)
+            state::<1, K>(&w)
         }
     } else {
-        state::<0>(&w)
+        state::<0, K>(&w)
     };
 
     // End: `back[e]` is the current step's value at n − 1 − e. Step s holds its values at
     // e = s + 1 and e = s; step s + 1 still lacks e = 1..=s, which follow from step s's
     // values at e − 1 ..= e + 1 with the fixed end at e = 0.
     let end = v[n - 1];
-    let mut back = [0f32; GROUP + 2];
+    let mut back = [0f32; BIG_GROUP + 2];
     back[0] = end;
     back[1] = st[0][0];
-    for s in 0..GROUP {
-        let mut next = [0f32; GROUP + 2];
+    for s in 0..K {
+        let mut next = [0f32; BIG_GROUP + 2];
         next[0] = end;
         for e in 1..=s {
             next[e] = co[s].apply(back[e + 1], back[e], back[e - 1]);
         }
-        if s + 1 < GROUP {
+        if s + 1 < K {
             next[s + 1] = st[s + 1][1];
             next[s + 2] = st[s + 1][0];
             back = next;
@@ -350,7 +362,7 @@ mod tests {
         // to three groups and a remainder.
         let (lambda, mu) = (Coef::new(0.6307), Coef::new(-0.6732));
         for n in 0..40usize {
-            for steps in 0..15u32 {
+            for steps in 0..23u32 {
                 let v = noisy(n.max(1), 7 * n as u64 + u64::from(steps));
                 let mut a = [0.0f32; 64];
                 for i in 0..n {
