@@ -237,8 +237,9 @@ impl<const N: usize> Kernel<N> {
 
         // 1. §2.3–2.4 on the raw line.
         let s_off = &mut self.s_off[..n];
-        c.capped_windows += bend::windows(x, z, d2, s_off, aux);
-        let (irr, non_finite) = bend::mark_irregular(x, z, s_off, aux, irregular, status);
+        let (capped, irr, non_finite) =
+            bend::windows_marked(x, z, d2, s_off, aux, irregular, status);
+        c.capped_windows += capped;
         c.irregular = irr;
         c.non_finite = non_finite;
         let kept = n - (irr + non_finite) as usize;
