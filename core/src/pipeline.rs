@@ -78,19 +78,50 @@ pub struct Pipeline<const RING: usize, const N: usize> {
     ingest: Ingest<RING, N>,
     kernel: Kernel<N>,
     c: PipelineCounters,
+    /// The assembler still has to be given the kernel's split parameters (see
+    /// [`Pipeline::new`]).
+    fresh: bool,
 }
 
 impl<const RING: usize, const N: usize> Pipeline<RING, N> {
     /// A pipeline with the default parameters.
-    pub fn new() -> Self {
-        let params = KernelParams::DEFAULT;
-        let mut ingest = Ingest::new();
-        ingest.set_split_params(params.split_params());
+    ///
+    /// `const`, so that the pipeline can be a `static` (the firmware's ~80 KiB then never
+    /// pass through its stack). The assembler takes the parameters' split rules on the first
+    /// [`Pipeline::run`], before it sees a point.
+    pub const fn new() -> Self {
         Self {
-            ingest,
-            kernel: Kernel::new(params),
-            c: PipelineCounters::default(),
+            ingest: Ingest::new(),
+            kernel: Kernel::new(KernelParams::DEFAULT),
+            c: PipelineCounters {
+                ingest: IngestCounters::ZERO,
+                kernel_lines: 0,
+                kernel_points: 0,
+                kept: 0,
+                irregular: 0,
+                no_neighbour: 0,
+                non_finite: 0,
+                peaks: 0,
+                left_candidates: 0,
+                right_candidates: 0,
+                configs_applied: 0,
+                configs_rejected: 0,
+                last_config_error: None,
+            },
+            fresh: true,
         }
+    }
+
+    /// The ring's free space, for a DMA engine or a `read()` call to fill in place;
+    /// follow with [`Pipeline::commit`].
+    pub fn free_slices_mut(&mut self) -> (&mut [u8], &mut [u8]) {
+        self.ingest.free_slices_mut()
+    }
+
+    /// Marks `n` bytes written through [`Pipeline::free_slices_mut`] as received; returns
+    /// the bytes that fit (the rest is counted as dropped).
+    pub fn commit(&mut self, n: usize) -> usize {
+        self.ingest.commit(n)
     }
 
     /// Offers bytes; returns how many were accepted (the rest is counted as dropped).
@@ -101,6 +132,11 @@ impl<const RING: usize, const N: usize> Pipeline<RING, N> {
     /// Processes every complete line in the ring, calling `on_line` with each result; a
     /// config packet reconfigures the kernel (bad ones are counted, the old parameters stay).
     pub fn run(&mut self, mut on_line: impl FnMut(&ScanlineOutput<'_>)) {
+        if self.fresh {
+            self.ingest
+                .set_split_params(self.kernel.params().split_params());
+            self.fresh = false;
+        }
         while let Some(ev) = self.ingest.poll() {
             match ev {
                 IngestEvent::Config(words) => {
@@ -165,21 +201,28 @@ impl<const RING: usize, const N: usize> Default for Pipeline<RING, N> {
 /// Writes all output packets of one line back to back into `buf` (see
 /// `docs/wire-format.md`); returns the bytes written. `buf` needs
 /// `wire::output_packet_len` of each fragment — at most
-/// ⌈len / `MAX_OUTPUT_POINTS_PER_PACKET`⌉ · `MAX_PACKET_LEN` bytes. Counters above 65 535
-/// saturate in the header's 16-bit fields. A non-finite point (status
-/// [`PointStatus::NonFinite`], which ingest normally drops before the kernel) is sent at
-/// x′ = z′ = 0 with its status, so the line still encodes.
+/// ⌈len / `MAX_OUTPUT_POINTS_PER_PACKET`⌉ · `MAX_PACKET_LEN` bytes. The header is
+/// [`output_header`]'s and point `i` is [`output_point`]'s (a sender short of RAM writes one
+/// packet at a time with them and `StreamEncoder::encode_output_fragment`, as the firmware
+/// does: the same bytes).
 pub fn encode_output(
     out: &ScanlineOutput<'_>,
     enc: &mut StreamEncoder,
     buf: &mut [u8],
 ) -> Result<usize, EncodeError> {
+    let header = output_header(out)?;
+    enc.encode_output_line(&header, |i| output_point(out, i), buf)
+}
+
+/// The wire header of a line's output packets. Counters above 65 535 saturate in the
+/// header's 16-bit fields.
+pub fn output_header(out: &ScanlineOutput<'_>) -> Result<OutputHeaderRepr, EncodeError> {
     let sat = |v: u32| u16::try_from(v).unwrap_or(u16::MAX);
     let line_len = u16::try_from(out.status.len()).map_err(|_| EncodeError::TooManyPoints {
         count: out.status.len(),
         max: usize::from(u16::MAX),
     })?;
-    let header = OutputHeaderRepr {
+    Ok(OutputHeaderRepr {
         index: out.index,
         start_time_ns: out.start_time_ns,
         params_hash: out.params_hash,
@@ -193,25 +236,25 @@ pub fn encode_output(
         irregular: sat(out.counters.irregular),
         no_neighbour: sat(out.counters.no_neighbour),
         peaks: sat(out.counters.peaks),
+    })
+}
+
+/// Output point `i` of a line. A non-finite point (status [`PointStatus::NonFinite`],
+/// which ingest normally drops before the kernel) is sent at x′ = z′ = 0 with its status,
+/// so the line still encodes.
+pub fn output_point(out: &ScanlineOutput<'_>, i: usize) -> Result<OutputPointRepr, EncodeError> {
+    let status = *out
+        .status
+        .get(i)
+        .ok_or(EncodeError::OutOfRange { index: i })?;
+    let get = |s: &[f32]| s.get(i).copied().unwrap_or(0.0);
+    let (x, z) = if status == PointStatus::NonFinite {
+        (0.0, 0.0)
+    } else {
+        (get(out.x_m), get(out.z_m))
     };
-    enc.encode_output_line(
-        &header,
-        |i| {
-            let status = *out
-                .status
-                .get(i)
-                .ok_or(EncodeError::OutOfRange { index: i })?;
-            let get = |s: &[f32]| s.get(i).copied().unwrap_or(0.0);
-            let (x, z) = if status == PointStatus::NonFinite {
-                (0.0, 0.0)
-            } else {
-                (get(out.x_m), get(out.z_m))
-            };
-            let tag = out.tag.get(i).copied().unwrap_or(0);
-            OutputPointRepr::from_f32(tag, x, z, get(out.rho_deg), status as u8, i)
-        },
-        buf,
-    )
+    let tag = out.tag.get(i).copied().unwrap_or(0);
+    OutputPointRepr::from_f32(tag, x, z, get(out.rho_deg), status as u8, i)
 }
 
 #[cfg(test)]
@@ -265,6 +308,28 @@ mod tests {
                 out.extend_from_slice(&buf[..n]);
             }
         }
+    }
+
+    /// `new` is `const`: a pipeline can be a `static`, and it behaves as one built at run
+    /// time (the derived values and the split rules are settled on first use).
+    #[test]
+    fn a_const_pipeline_runs_like_any_other() {
+        static CONST: Pipeline<RING, 512> = Pipeline::new();
+        assert_eq!(CONST.params(), &KernelParams::DEFAULT);
+        assert_eq!(CONST.counters(), PipelineCounters::default());
+        let mut enc = StreamEncoder::new();
+        let mut bytes = Vec::new();
+        stream(&mut enc, 2, &mut bytes);
+        let mut p = std::boxed::Box::new(Pipeline::<RING, 512>::new());
+        p.write(&bytes);
+        let mut hashes = Vec::new();
+        p.finish(|o| hashes.push((o.params_hash, o.left)));
+        assert_eq!(hashes, [(KernelParams::DEFAULT.hash(), Some(200)); 2]);
+        // The split rules in force are the parameters', applied before the first point.
+        assert_eq!(
+            p.ingest.split_params(),
+            KernelParams::DEFAULT.split_params()
+        );
     }
 
     #[test]

@@ -1,26 +1,19 @@
 //! The processing loop, the same on the board and in host tests: bytes from a byte link
-//! into the core's ring the way a DMA channel fills it, the kernel on every completed
-//! scanline, each line's output packets out through another byte link.
+//! into the core's ring the way a DMA channel fills it, the core's
+//! [`Pipeline`](curbtrace_core::Pipeline) on every completed scanline, each line's output
+//! packets out through another byte link, one packet at a time.
 //!
 //! The links are `embedded_io::{Read, Write}` (embedded-hal 1.0 has no serial traits), so
 //! a UART, SPI or DMA driver replaces the semihosting files of the QEMU build without this
-//! loop changing.
-//!
-//! [`Node`] is `curbtrace_core::pipeline::Pipeline` taken apart, for two reasons of memory:
-//! `Pipeline::new()` returns its ~80 KiB by value, which passes through the stack (the
-//! firmware's stack is far smaller), while [`Node::init`] builds ingest and kernel in place;
-//! and `pipeline::encode_output` needs a whole line's packets in one buffer (35 KiB for
-//! 2048 points), while [`emit_line`] sends one packet at a time. The per-event logic is
-//! `Pipeline::run`'s and the bytes are `encode_output`'s: `firmware/check.sh` compares the
-//! firmware's output with `curbtrace kernel`, which runs `Pipeline` and `encode_output`.
+//! loop changing. Everything between the links is the core's: `Pipeline::run` (ingest,
+//! config packets, kernel) and `pipeline::{output_header, output_point}` (the bytes
+//! `encode_output` writes), so `firmware/check.sh` compares the same code on two CPUs.
 
-use core::mem::MaybeUninit;
-use core::ptr::addr_of_mut;
-use curbtrace_core::kernel::{Kernel, KernelCounters, KernelParams, PointStatus, ScanlineOutput};
-use curbtrace_core::scanline::{Ingest, IngestCounters, IngestEvent};
+use curbtrace_core::kernel::{KernelCounters, ScanlineOutput};
+use curbtrace_core::pipeline::{self, Pipeline, PipelineCounters};
 use curbtrace_core::wire::{
-    EncodeError, OutputHeaderRepr, OutputPointRepr, StreamEncoder, MAX_OUTPUT_POINTS_PER_PACKET,
-    MAX_PACKET_LEN, MAX_POINTS_PER_PACKET, POINTS_PREFIX_LEN, POINT_RECORD_LEN,
+    EncodeError, StreamEncoder, MAX_OUTPUT_POINTS_PER_PACKET, MAX_PACKET_LEN,
+    MAX_POINTS_PER_PACKET, POINTS_PREFIX_LEN, POINT_RECORD_LEN,
 };
 
 use embedded_io::{Read, Write};
@@ -43,63 +36,16 @@ pub const RING: usize =
 /// Bytes moved per transfer into the ring (a DMA half-transfer, a `read()` call).
 pub const DMA_CHUNK: usize = 1024;
 
-/// Ingest and kernel: all the working memory of the core, for lines of up to `N` points.
-pub struct Node<const RING: usize, const N: usize> {
-    /// Ring, packet parser, scanline assembly.
-    pub ingest: Ingest<RING, N>,
-    /// The per-scanline kernel.
-    pub kernel: Kernel<N>,
-}
-
-impl<const RING: usize, const N: usize> Node<RING, N> {
-    /// An empty node running the default parameters until the stream's config packet.
-    pub fn new() -> Self {
-        let mut ingest = Ingest::new();
-        ingest.set_split_params(KernelParams::DEFAULT.split_params());
-        Self {
-            ingest,
-            kernel: Kernel::new(KernelParams::DEFAULT),
-        }
-    }
-}
-
-impl<const RING: usize, const N: usize> Node<RING, N> {
-    /// Constructs a node in place at `slot` (the node is ~80 KiB: built by value it would
-    /// pass through the stack, which the firmware keeps small).
-    pub fn init(slot: &mut MaybeUninit<Self>) -> &mut Self {
-        let p = slot.as_mut_ptr();
-        // SAFETY: `p` points to writable, properly aligned memory for a `Self`; both fields
-        // are written before the reference is created, so the node is fully initialised.
-        unsafe {
-            addr_of_mut!((*p).ingest).write(Ingest::new());
-            addr_of_mut!((*p).kernel).write(Kernel::new(KernelParams::DEFAULT));
-            let node = &mut *p;
-            node.ingest
-                .set_split_params(KernelParams::DEFAULT.split_params());
-            node
-        }
-    }
-}
-
-impl<const RING: usize, const N: usize> Default for Node<RING, N> {
-    fn default() -> Self {
-        Self::new()
-    }
-}
+/// The firmware's pipeline: ring, parser, assembly and kernel for its line size.
+pub type Node = Pipeline<RING, MAX_POINTS>;
 
 /// What a run did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Summary {
-    /// The ingest's counters at the end.
-    pub ingest: IngestCounters,
-    /// Kernel counters summed over all lines.
+    /// The pipeline's counters at the end (ingest, kernel sums, config packets).
+    pub counters: PipelineCounters,
+    /// Kernel counters summed over all lines (as the host's `curbtrace kernel` prints them).
     pub kernel: KernelCounters,
-    /// Lines processed.
-    pub lines: u32,
-    /// Config packets applied.
-    pub configs: u32,
-    /// Config packets whose parameters were rejected (the previous ones stayed).
-    pub configs_rejected: u32,
     /// Output packets written.
     pub packets_out: u32,
     /// Output bytes written.
@@ -120,19 +66,24 @@ pub enum Error<R, W> {
     RingStuck,
 }
 
-/// Runs the whole input stream through `node`, writing every line's output packets to
+/// Runs the whole input stream through `pipeline`, writing every line's output packets to
 /// `output`; `packet` is the one output packet buffer.
 pub fn run<R: Read, W: Write, const RING: usize, const N: usize>(
-    node: &mut Node<RING, N>,
+    pipeline: &mut Pipeline<RING, N>,
     input: &mut R,
     output: &mut W,
     packet: &mut [u8; MAX_PACKET_LEN],
 ) -> Result<Summary, Error<R::Error, W::Error>> {
-    let mut sum = Summary::default();
-    let mut enc = StreamEncoder::new();
+    let mut sink = Sink {
+        enc: StreamEncoder::new(),
+        packet,
+        output,
+        sum: Summary::default(),
+        failed: None,
+    };
     loop {
         // Fill the ring's free space in place, as a DMA channel would (no copy).
-        let (free, _) = node.ingest.free_slices_mut();
+        let (free, _) = pipeline.free_slices_mut();
         let want = free.len().min(DMA_CHUNK);
         if want == 0 {
             return Err(Error::RingStuck);
@@ -141,48 +92,40 @@ pub fn run<R: Read, W: Write, const RING: usize, const N: usize>(
         if n == 0 {
             break;
         }
-        node.ingest.commit(n);
-        drain(node, &mut enc, output, packet, &mut sum)?;
+        pipeline.commit(n);
+        pipeline.run(|out| sink.line(out));
+        if let Some(e) = sink.failed.take() {
+            return Err(e);
+        }
     }
-    node.ingest.finish();
-    drain(node, &mut enc, output, packet, &mut sum)?;
-    output.flush().map_err(Error::Write)?;
-    sum.ingest = node.ingest.counters();
-    Ok(sum)
+    pipeline.finish(|out| sink.line(out));
+    if let Some(e) = sink.failed.take() {
+        return Err(e);
+    }
+    sink.output.flush().map_err(Error::Write)?;
+    sink.sum.counters = pipeline.counters();
+    Ok(sink.sum)
 }
 
-/// Processes every event the ring holds.
-fn drain<W: Write, E, const RING: usize, const N: usize>(
-    node: &mut Node<RING, N>,
-    enc: &mut StreamEncoder,
-    output: &mut W,
-    packet: &mut [u8; MAX_PACKET_LEN],
-    sum: &mut Summary,
-) -> Result<(), Error<E, W::Error>> {
-    while let Some(event) = node.ingest.poll() {
-        match event {
-            IngestEvent::Config(words) => {
-                // As Pipeline::run: kernel and assembler from the next line on; a bad block
-                // is counted and the old parameters stay.
-                match KernelParams::from_words(&words)
-                    .and_then(|p| node.kernel.set_params(p).map(|()| p))
-                {
-                    Ok(p) => {
-                        node.ingest.set_split_params(p.split_params());
-                        sum.configs += 1;
-                    }
-                    Err(_) => sum.configs_rejected += 1,
-                }
-            }
-            IngestEvent::Line(line) => {
-                let out = node.kernel.process(line);
-                add_counters(&mut sum.kernel, &out.counters);
-                sum.lines += 1;
-                emit_line(&out, enc, packet, output, sum)?;
+/// Where `Pipeline::run` hands each line: encodes and writes it, keeps the first error
+/// (the closure cannot return one) and writes nothing after it.
+struct Sink<'a, W: Write, E> {
+    enc: StreamEncoder,
+    packet: &'a mut [u8; MAX_PACKET_LEN],
+    output: &'a mut W,
+    sum: Summary,
+    failed: Option<Error<E, W::Error>>,
+}
+
+impl<W: Write, E> Sink<'_, W, E> {
+    fn line(&mut self, out: &ScanlineOutput<'_>) {
+        add_counters(&mut self.sum.kernel, &out.counters);
+        if self.failed.is_none() {
+            if let Err(e) = emit_line(out, &mut self.enc, self.packet, self.output, &mut self.sum) {
+                self.failed = Some(e);
             }
         }
     }
-    Ok(())
 }
 
 fn add_counters(total: &mut KernelCounters, c: &KernelCounters) {
@@ -196,50 +139,8 @@ fn add_counters(total: &mut KernelCounters, c: &KernelCounters) {
     total.smooth_pieces += c.smooth_pieces;
 }
 
-/// The wire header of a line's output, as `pipeline::encode_output` builds it (counters
-/// above 65 535 saturate; they cannot reach that with 2048-point lines).
-pub fn output_header(out: &ScanlineOutput<'_>) -> Result<OutputHeaderRepr, EncodeError> {
-    let sat = |v: u32| u16::try_from(v).unwrap_or(u16::MAX);
-    let n = out.status.len();
-    Ok(OutputHeaderRepr {
-        index: out.index,
-        start_time_ns: out.start_time_ns,
-        params_hash: out.params_hash,
-        truncated: out.truncated,
-        line_len: u16::try_from(n).map_err(|_| EncodeError::TooManyPoints {
-            count: n,
-            max: usize::from(u16::MAX),
-        })?,
-        first: 0,
-        nadir: out.nadir,
-        left: out.left,
-        right: out.right,
-        kept: sat(out.counters.kept),
-        irregular: sat(out.counters.irregular),
-        no_neighbour: sat(out.counters.no_neighbour),
-        peaks: sat(out.counters.peaks),
-    })
-}
-
-/// Output point `i` of a line, as `pipeline::encode_output` converts it (a non-finite point
-/// goes out at x′ = z′ = 0 with its status).
-pub fn output_point(out: &ScanlineOutput<'_>, i: usize) -> Result<OutputPointRepr, EncodeError> {
-    let status = *out
-        .status
-        .get(i)
-        .ok_or(EncodeError::OutOfRange { index: i })?;
-    let get = |s: &[f32]| s.get(i).copied().unwrap_or(0.0);
-    let (x, z) = if status == PointStatus::NonFinite {
-        (0.0, 0.0)
-    } else {
-        (get(out.x_m), get(out.z_m))
-    };
-    let tag = out.tag.get(i).copied().unwrap_or(0);
-    OutputPointRepr::from_f32(tag, x, z, get(out.rho_deg), status as u8, i)
-}
-
 /// Writes one line's output packets, one packet buffer at a time (a whole 2048-point line
-/// would need 34 KiB at once).
+/// would need 34 KiB at once); the bytes are `pipeline::encode_output`'s.
 fn emit_line<W: Write, E>(
     out: &ScanlineOutput<'_>,
     enc: &mut StreamEncoder,
@@ -247,13 +148,12 @@ fn emit_line<W: Write, E>(
     output: &mut W,
     sum: &mut Summary,
 ) -> Result<(), Error<E, W::Error>> {
-    let header = output_header(out).map_err(|e| Error::Encode(out.index, e))?;
-    let point = |i: usize| output_point(out, i);
+    let header = pipeline::output_header(out).map_err(|e| Error::Encode(out.index, e))?;
     for k in 0..header.fragments() {
         let first = u16::try_from(k * MAX_OUTPUT_POINTS_PER_PACKET)
             .map_err(|_| Error::Encode(out.index, EncodeError::OutOfRange { index: k }))?;
         let n = enc
-            .encode_output_fragment(&header, first, point, packet)
+            .encode_output_fragment(&header, first, |i| pipeline::output_point(out, i), packet)
             .map_err(|e| Error::Encode(out.index, e))?;
         output.write_all(&packet[..n]).map_err(Error::Write)?;
         sum.packets_out += 1;
@@ -265,6 +165,7 @@ fn emit_line<W: Write, E>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use curbtrace_core::kernel::KernelParams;
     use curbtrace_core::wire::{OutputHeaderRepr, Packet, PointRecord, CONFIG_WORDS};
 
     /// A reader that hands out at most `step` bytes per call (a slow link).
@@ -332,7 +233,7 @@ mod tests {
     }
 
     fn run_all(input: &[u8], step: usize) -> (Summary, Vec<u8>) {
-        let mut node: Box<Node<RING, 512>> = Box::default();
+        let mut node: Box<Pipeline<RING, 512>> = Box::default();
         let mut packet = [0u8; MAX_PACKET_LEN];
         let mut out = Sink(Vec::new());
         let sum = run(
@@ -349,10 +250,11 @@ mod tests {
     fn chunking_does_not_change_the_output() {
         let input = stream(&KernelParams::DEFAULT.to_words(), 3, 300);
         let (sum, whole) = run_all(&input, usize::MAX);
-        assert_eq!(sum.lines, 3);
-        assert_eq!(sum.configs, 1);
-        assert_eq!(sum.ingest.points_in, 900);
-        assert_eq!(sum.ingest.bytes_dropped_full, 0);
+        assert_eq!(sum.counters.kernel_lines, 3);
+        assert_eq!(sum.counters.configs_applied, 1);
+        assert_eq!(sum.counters.ingest.points_in, 900);
+        assert_eq!(sum.counters.ingest.bytes_dropped_full, 0);
+        assert_eq!(sum.kernel.points_in, 900);
         // 300 points = 4 output packets of ≤ 88 points ((1472 − 56) / 16) per line.
         assert_eq!(MAX_OUTPUT_POINTS_PER_PACKET, 88);
         assert_eq!(sum.packets_out, 12);
@@ -360,7 +262,7 @@ mod tests {
         for step in [1, 7, 1000] {
             let (s, out) = run_all(&input, step);
             assert_eq!(out, whole, "step {step}");
-            assert_eq!(s.lines, 3);
+            assert_eq!(s.counters.kernel_lines, 3);
         }
         // Every packet is a valid output packet of a line with the nadir at its V.
         let mut at = 0;
@@ -384,8 +286,8 @@ mod tests {
         let mut words = KernelParams::DEFAULT.to_words();
         words[0] = f32::NAN.to_bits(); // d_b
         let (sum, _) = run_all(&stream(&words, 1, 100), 64);
-        assert_eq!(sum.configs, 0);
-        assert_eq!(sum.configs_rejected, 1);
-        assert_eq!(sum.lines, 1);
+        assert_eq!(sum.counters.configs_applied, 0);
+        assert_eq!(sum.counters.configs_rejected, 1);
+        assert_eq!(sum.counters.kernel_lines, 1);
     }
 }

@@ -17,7 +17,6 @@ mod stack;
 
 use curbtrace_firmware::args::{self, Command};
 
-use core::mem::MaybeUninit;
 use core::ptr::addr_of_mut;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
@@ -93,18 +92,14 @@ fn main() -> ! {
             exit_failure()
         }
     };
-    // All the core's working memory, in .bss: constructed in place, never on the stack.
-    static mut NODE: MaybeUninit<Node<RING, MAX_POINTS>> = MaybeUninit::uninit();
+    // All the core's working memory, a `static` built by the core's `const fn`
+    // `Pipeline::new` (its initial image is part of .data): it never passes through the
+    // stack.
+    static mut NODE: Node = Node::new();
     static mut PACKET: [u8; MAX_PACKET_LEN] = [0; MAX_PACKET_LEN];
     // SAFETY: main runs once and no interrupt touches these; these are the only references.
-    let (node, packet) = unsafe {
-        (
-            Node::init(&mut *addr_of_mut!(NODE)),
-            &mut *addr_of_mut!(PACKET),
-        )
-    };
-    // Start-up's deepest stack use is Kernel::new building its ~13 KiB by value; measure the
-    // processing loop on its own from here.
+    let (node, packet) = unsafe { (&mut *addr_of_mut!(NODE), &mut *addr_of_mut!(PACKET)) };
+    // Measure the processing loop's stack on its own from here (start-up: opening files).
     let stack_init = stack::repaint();
     let summary = match app::run(node, &mut input, &mut output, packet) {
         Ok(s) => s,
@@ -113,7 +108,7 @@ fn main() -> ! {
             exit_failure()
         }
     };
-    let c = &summary.ingest;
+    let c = &summary.counters.ingest;
     figure!("bytes_in", c.bytes_in);
     figure!("bytes_dropped_full", c.bytes_dropped_full);
     figure!("bytes_garbage", c.bytes_garbage);
@@ -121,9 +116,9 @@ fn main() -> ! {
     figure!("seq_gaps", c.seq_gaps);
     figure!("points_in", c.points_in);
     figure!("points_truncated", c.points_truncated);
-    figure!("lines", summary.lines);
-    figure!("configs", summary.configs);
-    figure!("configs_rejected", summary.configs_rejected);
+    figure!("lines", summary.counters.kernel_lines);
+    figure!("configs", summary.counters.configs_applied);
+    figure!("configs_rejected", summary.counters.configs_rejected);
     figure!("kept", summary.kernel.kept);
     figure!("irregular", summary.kernel.irregular);
     figure!("no_neighbour", summary.kernel.no_neighbour);

@@ -58,10 +58,88 @@ fn beyond(x: &[f32], z: &[f32], a: usize, b: usize, d2: f32) -> bool {
 /// `t_off[i]`. Returns how many windows stopped at [`MAX_SIDE`] with the next point still
 /// within d_b (either side).
 ///
+/// Two forms, the same windows (tested): on 64-bit hosts [`windows_interleaved`], tuned
+/// for an out-of-order CPU; elsewhere (the M4F, in order, no branch predictor to speak of)
+/// [`windows_sweeps`], which counts about half the instructions there.
+pub(crate) fn windows(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8], t_off: &mut [u8]) -> u32 {
+    if cfg!(target_pointer_width = "64") {
+        windows_interleaved(x, z, d2, s_off, t_off)
+    } else {
+        windows_sweeps(x, z, d2, s_off, t_off)
+    }
+}
+
+/// [`windows`] as two plain sweeps, one after the other: per point, p_i is loaded once and
+/// the walk tests each candidate once (two distance tests when the window moves by one
+/// point, one when it stays) — the interleaved form tests one position twice.
+#[cfg_attr(all(not(test), target_pointer_width = "64"), allow(dead_code))]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN counts as beyond, as in `beyond`
+fn windows_sweeps(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8], t_off: &mut [u8]) -> u32 {
+    let n = x.len();
+    let (z, s_off, t_off) = (&z[..n], &mut s_off[..n], &mut t_off[..n]);
+    let mut capped = forward_sweep(x, z, d2, s_off);
+    // Backward: t(j) is the last index ≤ min(t(j + 1), j + MAX_SIDE) within d_b; j ≤ t < n.
+    let mut t = n.saturating_sub(1);
+    for j in (0..n).rev() {
+        let (xj, zj) = (x[j], z[j]);
+        let far = |k: usize| {
+            let (dx, dz) = (x[k] - xj, z[k] - zj);
+            !(dx * dx + dz * dz <= d2)
+        };
+        // j ≤ t: min(t, j + MAX_SIDE) as a comparison of the offset.
+        if t - j > MAX_SIDE {
+            t = j + MAX_SIDE;
+            if !far(t + 1) {
+                capped += 1;
+            }
+        }
+        while t > j && far(t) {
+            t -= 1;
+        }
+        t_off[j] = (t - j) as u8;
+    }
+    capped
+}
+
+/// The forward sweep of [`windows_sweeps`]: i − s(i) into `s_off`; returns the windows
+/// capped on the left.
+#[inline(always)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN counts as beyond, as in `beyond`
+fn forward_sweep(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8]) -> u32 {
+    let n = x.len();
+    let (z, s_off) = (&z[..n], &mut s_off[..n]);
+    let mut capped = 0u32;
+    // Forward: s(i) is the first j ≥ max(s(i − 1), i − MAX_SIDE) within d_b; s ≤ i < n.
+    let mut s = 0usize;
+    for i in 0..n {
+        let (xi, zi) = (x[i], z[i]);
+        let far = |j: usize| {
+            let (dx, dz) = (x[j] - xi, z[j] - zi);
+            !(dx * dx + dz * dz <= d2)
+        };
+        // s ≤ i: max(s, i − MAX_SIDE) without the saturating subtraction.
+        if i - s > MAX_SIDE {
+            s = i - MAX_SIDE;
+        }
+        while s < i && far(s) {
+            s += 1;
+        }
+        let off = i - s;
+        s_off[i] = off as u8;
+        if off == MAX_SIDE && s > 0 && !far(s - 1) {
+            capped += 1;
+        }
+    }
+    capped
+}
+
+/// [`windows`] with the forward and the backward sweep in one loop.
+///
 /// Each sweep is a serial chain (the next position depends on the last comparison: load,
 /// subtract, square, add, compare ≈ 20 cycles per step); running the forward and the
 /// backward sweep in the same loop gives the CPU two independent chains to overlap.
-pub(crate) fn windows(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8], t_off: &mut [u8]) -> u32 {
+#[cfg_attr(all(not(test), not(target_pointer_width = "64")), allow(dead_code))]
+fn windows_interleaved(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8], t_off: &mut [u8]) -> u32 {
     let n = x.len();
     let (z, s_off, t_off) = (&z[..n], &mut s_off[..n], &mut t_off[..n]);
     let mut capped = 0u32;
@@ -96,6 +174,7 @@ pub(crate) fn windows(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8], t_off: &m
 
 /// The forward sweep's left neighbour of `i`, given the previous one.
 #[inline(always)]
+#[cfg_attr(all(not(test), not(target_pointer_width = "64")), allow(dead_code))]
 fn left_neighbour(x: &[f32], z: &[f32], d2: f32, s_prev: usize, i: usize) -> usize {
     let mut s = s_prev.max(i.saturating_sub(MAX_SIDE));
     // s usually moves by 0 or 1 per point: take that step without a branch, loop only for
@@ -117,6 +196,9 @@ pub(crate) struct Threshold {
 }
 
 impl Threshold {
+    /// A placeholder before the parameters' threshold is computed.
+    pub(crate) const PENDING: Self = Self { cos: 0.0, sin: 0.0 };
+
     /// The threshold `deg` degrees (0 < deg ≤ 180).
     pub(crate) fn new(deg: f32) -> Self {
         let r = deg / RAD_TO_DEG;
@@ -143,6 +225,7 @@ pub const MAX_COORD_M: f32 = 2000.0;
 ///
 /// No atan2: with φ = atan2(|c|, d) ∈ [0, π] and θ the threshold, φ > θ ⟺ sin(φ − θ) > 0
 /// ⟺ |c|·cos θ − d·sin θ > 0 (both sides scaled by |a||b| > 0).
+#[inline(never)] // its own registers: inlined into `process`, it rematerialised addresses
 pub(crate) fn mark_irregular(
     x: &[f32],
     z: &[f32],
@@ -154,42 +237,118 @@ pub(crate) fn mark_irregular(
     let n = x.len();
     let (z, s_off, t_off, status) = (&z[..n], &s_off[..n], &t_off[..n], &mut status[..n]);
     let (mut irregular, mut non_finite) = (0u32, 0u32);
-    for i in 0..n {
-        let s = i - usize::from(s_off[i]);
-        let t = i + usize::from(t_off[i]);
-        let (xi, zi) = (x[i], z[i]);
-        // Out of range counts as non-finite: the wire carries any finite f32, but squares of
-        // coordinates near f32::MAX overflow in the bend angle and in smoothing (found by the
-        // `kernel_points` fuzz target), and output packets hold |x′|, |z′| < 2147 m.
-        // `contains` is false for NaN and ±inf.
-        if !((-MAX_COORD_M..=MAX_COORD_M).contains(&xi)
-            && (-MAX_COORD_M..=MAX_COORD_M).contains(&zi))
-        {
-            status[i] = PointStatus::NonFinite;
-            non_finite += 1;
-            continue;
-        }
-        // An isolated point (nothing within d_b on either side: a spike taller than d_b)
-        // is judged by its adjacent points instead, or it could never be removed.
-        let (sj, tj) = if s == i && t == i && i > 0 && i + 1 < n {
-            (i - 1, i + 1)
-        } else {
-            (s, t)
-        };
-        let (ax, az) = (xi - x[sj], zi - z[sj]);
-        let (bx, bz) = (x[tj] - xi, z[tj] - zi);
-        let c = ax * bz - az * bx;
-        let d = ax * bx + az * bz;
-        // With s == i or t == i, c = d = 0 and the test is false: kept.
-        if math::abs(c) * thr.cos - d * thr.sin > 0.0 {
-            status[i] = PointStatus::Irregular;
-            irregular += 1;
-        } else {
-            status[i] = PointStatus::Kept;
-        }
+    // Iterators rather than indices for the per-point arrays: each gets its own pointer
+    // (on the M4F, indexing them from one base rematerialised large offsets every point).
+    let per_point = status.iter_mut().zip(s_off.iter().zip(t_off));
+    for (i, (st, (&so, &to))) in per_point.enumerate() {
+        *st = judge(x, z, i, usize::from(so), usize::from(to), thr);
+        irregular += u32::from(*st == PointStatus::Irregular);
+        non_finite += u32::from(*st == PointStatus::NonFinite);
     }
     (irregular, non_finite)
 }
+
+/// [`mark_irregular`]'s verdict on point `i` (< `x.len()`) with window offsets `so`, `to`.
+#[inline(always)]
+fn judge(x: &[f32], z: &[f32], i: usize, so: usize, to: usize, thr: Threshold) -> PointStatus {
+    let n = x.len();
+    let z = &z[..n];
+    let (xi, zi) = (x[i], z[i]);
+    // Out of range counts as non-finite: the wire carries any finite f32, but squares of
+    // coordinates near f32::MAX overflow in the bend angle and in smoothing (found by the
+    // `kernel_points` fuzz target), and output packets hold |x′|, |z′| < 2147 m.
+    // |v| ≤ MAX_COORD_M compared on the bit patterns of |x′| and |z′| (monotone for
+    // non-negative floats; NaN and ±inf lie above): the same test as
+    // `(-MAX..=MAX).contains(&v)` on both, in integer instructions.
+    let mag = (xi.to_bits() & 0x7FFF_FFFF).max(zi.to_bits() & 0x7FFF_FFFF);
+    if mag > MAX_COORD_BITS {
+        return PointStatus::NonFinite;
+    }
+    // An isolated point (nothing within d_b on either side: a spike taller than d_b)
+    // is judged by its adjacent points instead, or it could never be removed.
+    let (sj, tj) = if so == 0 && to == 0 && i > 0 && i + 1 < n {
+        (i - 1, i + 1)
+    } else {
+        (i - so, i + to)
+    };
+    let (ax, az) = (xi - x[sj], zi - z[sj]);
+    let (bx, bz) = (x[tj] - xi, z[tj] - zi);
+    let c = ax * bz - az * bx;
+    let d = ax * bx + az * bz;
+    // With s == i or t == i, c = d = 0 and the test is false: kept.
+    if math::abs(c) * thr.cos - d * thr.sin > 0.0 {
+        PointStatus::Irregular
+    } else {
+        PointStatus::Kept
+    }
+}
+
+/// [`windows`] and then [`mark_irregular`] on the raw line: returns (capped windows,
+/// irregular, non-finite). On the M4F the judgement runs inside the backward sweep, while
+/// the point and its window are still in registers; elsewhere it is the two calls.
+pub(crate) fn windows_marked(
+    x: &[f32],
+    z: &[f32],
+    d2: f32,
+    s_off: &mut [u8],
+    t_off: &mut [u8],
+    thr: Threshold,
+    status: &mut [PointStatus],
+) -> (u32, u32, u32) {
+    if cfg!(target_pointer_width = "64") {
+        let capped = windows(x, z, d2, s_off, t_off);
+        let (irr, nf) = mark_irregular(x, z, s_off, t_off, thr, status);
+        (capped, irr, nf)
+    } else {
+        windows_sweeps_marked(x, z, d2, s_off, t_off, thr, status)
+    }
+}
+
+/// [`windows_sweeps`] with [`judge`] in the backward sweep.
+#[inline(never)] // its own registers (see `mark_irregular`)
+#[cfg_attr(all(not(test), target_pointer_width = "64"), allow(dead_code))]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN counts as beyond, as in `beyond`
+fn windows_sweeps_marked(
+    x: &[f32],
+    z: &[f32],
+    d2: f32,
+    s_off: &mut [u8],
+    t_off: &mut [u8],
+    thr: Threshold,
+    status: &mut [PointStatus],
+) -> (u32, u32, u32) {
+    let n = x.len();
+    let (z, s_off, t_off, status) = (&z[..n], &mut s_off[..n], &mut t_off[..n], &mut status[..n]);
+    let mut capped = forward_sweep(x, z, d2, s_off);
+    let (mut irregular, mut non_finite) = (0u32, 0u32);
+    let mut t = n.saturating_sub(1);
+    for j in (0..n).rev() {
+        let (xj, zj) = (x[j], z[j]);
+        let far = |k: usize| {
+            let (dx, dz) = (x[k] - xj, z[k] - zj);
+            !(dx * dx + dz * dz <= d2)
+        };
+        if t - j > MAX_SIDE {
+            t = j + MAX_SIDE;
+            if !far(t + 1) {
+                capped += 1;
+            }
+        }
+        while t > j && far(t) {
+            t -= 1;
+        }
+        t_off[j] = (t - j) as u8;
+        let st = judge(x, z, j, usize::from(s_off[j]), t - j, thr);
+        status[j] = st;
+        irregular += u32::from(st == PointStatus::Irregular);
+        non_finite += u32::from(st == PointStatus::NonFinite);
+    }
+    (capped, irregular, non_finite)
+}
+
+/// Bit pattern of [`MAX_COORD_M`].
+const MAX_COORD_BITS: u32 = 0x44FA_0000;
+const _: () = assert!(MAX_COORD_M.to_bits() == MAX_COORD_BITS);
 
 /// The signed bend angle at `i` with neighbours `s` and `t`, degrees in (−180, 180]
 /// (SPEC §2 sign rule; see the module docs).
@@ -229,6 +388,7 @@ pub(crate) fn bend_angle_deg<M: Backend>(
 
 /// ρ on the (smoothed) line for every point, with the offsets from [`windows`]; 0 where a
 /// side has no neighbour.
+#[inline(never)] // its own registers (see `mark_irregular`)
 pub(crate) fn bend_angles<M: Backend>(
     x: &[f32],
     z: &[f32],
@@ -328,6 +488,72 @@ mod tests {
         for i in 0..n {
             assert_eq!(usize::from(t_off[i]), 3.min(n - 1 - i), "t at {i}");
             assert_eq!(usize::from(s_off[i]), 3.min(i), "s at {i}");
+        }
+    }
+
+    #[test]
+    fn both_window_forms_agree() {
+        // Noisy profiles with folds, runs of coincident points longer than MAX_SIDE,
+        // gaps and non-finite points (a deterministic LCG).
+        let mut r = 12345u64;
+        let mut u = || {
+            r = r
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((r >> 40) as f32) / ((1u64 << 24) as f32)
+        };
+        const N: usize = 900;
+        for case in 0..24 {
+            let mut x = [0f32; N];
+            let mut z = [0f32; N];
+            let n = [N, 1, 2, 3, 300, 599][case % 6];
+            let mut px = 1.0f32;
+            for i in 0..n {
+                let kind = u();
+                px += if case % 4 == 0 && (300..600).contains(&i) {
+                    0.0 // a run of coincident points
+                } else if kind < 0.05 {
+                    -0.02 // fold back
+                } else if kind < 0.08 {
+                    0.3 // gap
+                } else {
+                    0.01 * u()
+                };
+                x[i] = px;
+                z[i] = -2.0 + 0.02 * u();
+                if case % 3 == 1 && kind > 0.99 {
+                    x[i] = f32::NAN;
+                }
+                if case % 4 != 0 && case % 5 == 2 && kind > 0.985 {
+                    z[i] += if kind > 0.995 { 3000.0 } else { 0.5 }; // out of range, spike
+                }
+            }
+            for d2 in [0.0025f32, 0.01, 0.0] {
+                let (mut s1, mut t1) = ([0u8; N], [0u8; N]);
+                let (mut s2, mut t2) = ([0u8; N], [0u8; N]);
+                let c1 = windows_interleaved(&x[..n], &z[..n], d2, &mut s1, &mut t1);
+                let c2 = windows_sweeps(&x[..n], &z[..n], d2, &mut s2, &mut t2);
+                assert_eq!(c1, c2, "case {case} d2 {d2}");
+                assert_eq!(s1, s2, "case {case} d2 {d2}");
+                assert_eq!(t1, t2, "case {case} d2 {d2}");
+                // The fused judgement gives what the separate pass gives.
+                let thr = Threshold::new(120.0);
+                let mut st1 = [PointStatus::Kept; N];
+                let (i1, n1) = mark_irregular(&x[..n], &z[..n], &s1, &t1, thr, &mut st1);
+                let (mut s3, mut t3) = ([0u8; N], [0u8; N]);
+                let mut st3 = [PointStatus::Kept; N];
+                let r3 =
+                    windows_sweeps_marked(&x[..n], &z[..n], d2, &mut s3, &mut t3, thr, &mut st3);
+                assert_eq!(r3, (c1, i1, n1), "case {case} d2 {d2}");
+                assert_eq!((s3, t3), (s1, t1));
+                assert_eq!(st3[..n], st1[..n], "case {case} d2 {d2}");
+                if case % 3 == 1 && n == N {
+                    assert!(n1 > 0, "NaN points are marked");
+                }
+                if case % 4 == 0 && n == N && d2 > 0.0 {
+                    assert!(c1 > 0, "the run of coincident points caps windows");
+                }
+            }
         }
     }
 

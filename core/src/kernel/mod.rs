@@ -133,6 +133,12 @@ struct Derived {
 }
 
 impl Derived {
+    /// Stands in until [`Derived::new`] has run (never used for a line).
+    const PENDING: Self = Self {
+        d2: 0.0,
+        irregular: bend::Threshold::PENDING,
+    };
+
     fn new(p: &KernelParams) -> Self {
         Self {
             d2: p.d_b_m * p.d_b_m,
@@ -157,21 +163,30 @@ pub struct Kernel<const N: usize> {
     s_off: [u8; N],
     /// The peak search's window-maximum deque.
     deque: [u16; seed::DEQUE_LEN],
+    /// `params_hash` and `derived` are still to be computed from `params` (a kernel made
+    /// by the `const` [`Kernel::new`] computes them on its first line).
+    fresh: bool,
 }
 
 impl<const N: usize> Kernel<N> {
     /// A kernel running `params` (taken as they are; [`Kernel::set_params`] checks them).
-    pub fn new(params: KernelParams) -> Self {
+    ///
+    /// `const`, so that a kernel can be a `static` (on the firmware, built in place rather
+    /// than passed through a small stack): the values derived from the parameters (their
+    /// hash, the irregular threshold's cosine and sine — libm is not `const`) are computed
+    /// when the first line is processed.
+    pub const fn new(params: KernelParams) -> Self {
         const { assert!(N <= u16::MAX as usize, "Kernel<N>: N must fit a u16 index") };
         Self {
-            params_hash: params.hash(),
-            derived: Derived::new(&params),
+            params_hash: 0,
+            derived: Derived::PENDING,
             params,
             rho: [0.0; N],
             status: [PointStatus::Kept; N],
             aux: [0; N],
             s_off: [0; N],
             deque: [0; seed::DEQUE_LEN],
+            fresh: true,
         }
     }
 
@@ -186,6 +201,7 @@ impl<const N: usize> Kernel<N> {
         self.params = params;
         self.params_hash = params.hash();
         self.derived = Derived::new(&params);
+        self.fresh = false;
         Ok(())
     }
 
@@ -201,6 +217,11 @@ impl<const N: usize> Kernel<N> {
         &'a mut self,
         line: &'a mut Line<N>,
     ) -> ScanlineOutput<'a> {
+        if self.fresh {
+            self.params_hash = self.params.hash();
+            self.derived = Derived::new(&self.params);
+            self.fresh = false;
+        }
         let n = line.len.min(N);
         let p = self.params;
         let Derived { d2, irregular } = self.derived;
@@ -216,16 +237,26 @@ impl<const N: usize> Kernel<N> {
 
         // 1. §2.3–2.4 on the raw line.
         let s_off = &mut self.s_off[..n];
-        c.capped_windows += bend::windows(x, z, d2, s_off, aux);
-        let (irr, non_finite) = bend::mark_irregular(x, z, s_off, aux, irregular, status);
+        let (capped, irr, non_finite) =
+            bend::windows_marked(x, z, d2, s_off, aux, irregular, status);
+        c.capped_windows += capped;
         c.irregular = irr;
         c.non_finite = non_finite;
         let kept = n - (irr + non_finite) as usize;
 
         // 2. Kept points to the front, in order.
+        // Points before the first set-aside one stay where they are.
+        let first_out = if kept < n {
+            status
+                .iter()
+                .position(|st| *st != PointStatus::Kept)
+                .unwrap_or(n)
+        } else {
+            n
+        };
         if kept < n {
-            let mut w = 0;
-            for (i, st) in status.iter().enumerate() {
+            let mut w = first_out;
+            for (i, st) in status.iter().enumerate().skip(first_out + 1) {
                 if *st == PointStatus::Kept {
                     x.swap(w, i);
                     z.swap(w, i);
@@ -275,9 +306,10 @@ impl<const N: usize> Kernel<N> {
                 *st = status_of(a);
             }
         } else {
+            // Points before `first_out` never moved (w = i there).
             let mut w = kept;
             let mut map = idx;
-            for i in (0..n).rev() {
+            for i in (first_out..n).rev() {
                 if status[i] == PointStatus::Kept {
                     w -= 1;
                     x.swap(w, i);
@@ -290,6 +322,9 @@ impl<const N: usize> Kernel<N> {
                         }
                     }
                 }
+            }
+            for (st, &a) in status[..first_out].iter_mut().zip(aux.iter()) {
+                *st = status_of(a);
             }
             idx = map;
         }

@@ -117,6 +117,45 @@ pub struct IngestCounters {
     pub split_end: u64,
 }
 
+impl IngestCounters {
+    /// All zero (`const`, unlike `Default::default`).
+    pub const ZERO: Self = IngestCounters {
+        bytes_in: 0,
+        bytes_dropped_full: 0,
+        bytes_garbage: 0,
+        bytes_rejected: 0,
+        bytes_packets: 0,
+        bytes_buffered: 0,
+        crc_errors: 0,
+        bad_length: 0,
+        cut_at_end: 0,
+        bad_version: 0,
+        bad_kind: 0,
+        bad_kind_length: 0,
+        reserved_flags: 0,
+        output_ignored: 0,
+        packets_points: 0,
+        packets_config: 0,
+        seq_gaps: 0,
+        packets_missing: 0,
+        points_in: 0,
+        points_non_finite: 0,
+        points_reserved_flags: 0,
+        points_time_overflow: 0,
+        points_pending: 0,
+        points_in_lines: 0,
+        points_truncated: 0,
+        lines: 0,
+        lines_truncated: 0,
+        split_line_start: 0,
+        split_zenith: 0,
+        split_time_gap: 0,
+        split_seq_gap: 0,
+        split_config: 0,
+        split_end: 0,
+    };
+}
+
 /// The points packet being read at the front of the ring.
 #[derive(Clone, Copy, Debug)]
 struct Current {
@@ -161,41 +200,7 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
             pending_config: None,
             next_seq: None,
             finishing: false,
-            c: IngestCounters {
-                bytes_in: 0,
-                bytes_dropped_full: 0,
-                bytes_garbage: 0,
-                bytes_rejected: 0,
-                bytes_packets: 0,
-                bytes_buffered: 0,
-                crc_errors: 0,
-                bad_length: 0,
-                cut_at_end: 0,
-                bad_version: 0,
-                bad_kind: 0,
-                bad_kind_length: 0,
-                reserved_flags: 0,
-                output_ignored: 0,
-                packets_points: 0,
-                packets_config: 0,
-                seq_gaps: 0,
-                packets_missing: 0,
-                points_in: 0,
-                points_non_finite: 0,
-                points_reserved_flags: 0,
-                points_time_overflow: 0,
-                points_pending: 0,
-                points_in_lines: 0,
-                points_truncated: 0,
-                lines: 0,
-                lines_truncated: 0,
-                split_line_start: 0,
-                split_zenith: 0,
-                split_time_gap: 0,
-                split_seq_gap: 0,
-                split_config: 0,
-                split_end: 0,
-            },
+            c: IngestCounters::ZERO,
         }
     }
 
@@ -278,16 +283,20 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
 
     fn step(&mut self) -> Step {
         if let Some(mut cur) = self.cur {
+            // The ring does not change while its records are assembled: split it once.
+            // `points_in` counts every record taken off (`cur.next` advanced), added up
+            // once at the end of the loop rather than per point.
+            let (a, b) = self.ring.as_slices();
+            let first = cur.next;
             while cur.next < cur.count {
                 let at = HEADER_LEN + POINTS_PREFIX_LEN + cur.next * POINT_RECORD_LEN;
                 // Parse in place when the record is contiguous; copy it out only when it
                 // straddles the ring's seam. The scanner checked the packet is all there.
-                let (a, _) = self.ring.as_slices();
                 let parsed = match a.get(at..at + POINT_RECORD_LEN) {
                     Some(rec) => PointRecord::parse(rec),
                     None => {
                         let mut rec = [0u8; POINT_RECORD_LEN];
-                        let _ = self.ring.peek(at, &mut rec);
+                        let _ = crate::wire::copy_from_two(a, b, at, &mut rec);
                         PointRecord::parse(&rec)
                     }
                 };
@@ -295,7 +304,6 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
                     Ok(p) => p,
                     Err(e) => {
                         cur.next += 1;
-                        self.c.points_in += 1;
                         match e {
                             WireError::NonFinite { .. } => self.c.points_non_finite += 1,
                             _ => self.c.points_reserved_flags += 1,
@@ -305,21 +313,19 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
                 };
                 let Some(t) = cur.base_time_ns.checked_add(u64::from(p.dt_ns)) else {
                     cur.next += 1;
-                    self.c.points_in += 1;
                     self.c.points_time_overflow += 1;
                     continue;
                 };
                 match self.asm.offer(t, &p) {
-                    Offer::Taken => {
-                        cur.next += 1;
-                        self.c.points_in += 1;
-                    }
+                    Offer::Taken => cur.next += 1,
                     Offer::Split(_) => {
+                        self.c.points_in += (cur.next - first) as u64;
                         self.cur = Some(cur);
                         return Step::Line;
                     }
                 }
             }
+            self.c.points_in += (cur.next - first) as u64;
             self.ring.consume(cur.len);
             self.c.bytes_packets += cur.len as u64;
             self.cur = None;

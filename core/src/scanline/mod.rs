@@ -99,14 +99,17 @@ impl<const N: usize> Line<N> {
 
     /// Appends a point; hands it back when the line is full (and counts it as truncated).
     pub fn push(&mut self, x_m: f32, z_m: f32, tag: u32) -> Result<(), (f32, f32, u32)> {
-        if self.len >= N {
+        // `len` read once: re-read after each store (it might alias them, for all the
+        // compiler knows once this is inlined) it cost a load and a bounds check each.
+        let i = self.len;
+        if i >= N {
             self.truncated = self.truncated.saturating_add(1);
             return Err((x_m, z_m, tag));
         }
-        self.x_m[self.len] = x_m;
-        self.z_m[self.len] = z_m;
-        self.tag[self.len] = tag;
-        self.len += 1;
+        self.x_m[i] = x_m;
+        self.z_m[i] = z_m;
+        self.tag[i] = tag;
+        self.len = i + 1;
         Ok(())
     }
 }

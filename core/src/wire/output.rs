@@ -113,6 +113,26 @@ fn scale_round(v: f32, scale: f32, lo: i32, hi: i32) -> Option<i32> {
     (lo..=hi).contains(&r).then_some(r)
 }
 
+/// [`scale_round`] for the common case, in fewer instructions (the output encodes three
+/// values per point): `None` whenever |v · scale| ≥ 2^30 or `v` is NaN, and then the caller
+/// takes [`scale_round`]; otherwise the same value (tested against it).
+///
+/// Why it is the same: 2·(v·scale) = v·(2·scale) exactly (doubling is exact, and rounding
+/// commutes with it), so q = trunc(2s) = 2·trunc(s) + trunc(2·frac) with trunc(2·frac) ∈
+/// {−1, 0, 1} of the sign of s — 1 exactly when frac ≥ 0.5, −1 exactly when frac ≤ −0.5.
+/// Then (q + 1) / 2 for q ≥ 0 and (q − 1) / 2 for q < 0 (integer division truncates) is
+/// s rounded half away from zero. |q| < 2^31: no overflow anywhere.
+#[inline(always)]
+fn scale_round_fast(v: f32, twice_scale: f32) -> Option<i32> {
+    let s2 = v * twice_scale;
+    // |s2| < 2^31 (bit pattern of 2^31 is 0x4F00_0000); false for NaN and ±inf.
+    if s2.to_bits() & 0x7FFF_FFFF >= 0x4F00_0000 {
+        return None;
+    }
+    let q = s2 as i32; // truncates; exact in range
+    Some((q + ((q >> 31) | 1)) / 2)
+}
+
 impl OutputPointRepr {
     /// Builds a point from the kernel's f32 values: x′, z′ in metres (rounded to µm), ρ in
     /// degrees (rounded to centidegrees; −180.00 becomes +180.00). `index` is reported in
@@ -126,6 +146,23 @@ impl OutputPointRepr {
         status: u8,
         index: usize,
     ) -> Result<Self, EncodeError> {
+        if let (Some(x_um), Some(z_um), Some(rho)) = (
+            scale_round_fast(x_m, 2e6),
+            scale_round_fast(z_m, 2e6),
+            scale_round_fast(rho_deg, 200.0),
+        ) {
+            // |x_um|, |z_um| ≤ 2^30: in range of the i32 fields; ρ needs its own range.
+            if (-18_000..=18_000).contains(&rho) {
+                return Ok(Self {
+                    tag,
+                    x_um,
+                    z_um,
+                    rho_cdeg: if rho == -18_000 { 18_000 } else { rho as i16 },
+                    status,
+                });
+            }
+        }
+        // Large, non-finite or out-of-range values: the general path and its errors.
         if !(x_m.is_finite() && z_m.is_finite() && rho_deg.is_finite()) {
             return Err(EncodeError::NonFinite { index });
         }
@@ -200,15 +237,40 @@ impl OutputPointRepr {
         if !(-17_999..=18_000).contains(&self.rho_cdeg) {
             return Err(EncodeError::OutOfRange { index });
         }
-        put_bytes(out, field::out_point::TAG.start, &self.tag.to_le_bytes());
-        put_bytes(out, field::out_point::X_UM.start, &self.x_um.to_le_bytes());
-        put_bytes(out, field::out_point::Z_UM.start, &self.z_um.to_le_bytes());
-        put_bytes(
-            out,
-            field::out_point::RHO_CDEG.start,
-            &self.rho_cdeg.to_le_bytes(),
+        // The record in one piece (4 word stores on the M4F instead of 16 byte copies).
+        let (t, x, z, r) = (
+            self.tag.to_le_bytes(),
+            self.x_um.to_le_bytes(),
+            self.z_um.to_le_bytes(),
+            self.rho_cdeg.to_le_bytes(),
         );
-        put_bytes(out, field::out_point::STATUS, &[self.status, 0]);
+        let rec: [u8; OUTPUT_POINT_LEN] = [
+            t[0],
+            t[1],
+            t[2],
+            t[3],
+            x[0],
+            x[1],
+            x[2],
+            x[3],
+            z[0],
+            z[1],
+            z[2],
+            z[3],
+            r[0],
+            r[1],
+            self.status,
+            0,
+        ];
+        const _: () = assert!(
+            field::out_point::TAG.start == 0
+                && field::out_point::X_UM.start == 4
+                && field::out_point::Z_UM.start == 8
+                && field::out_point::RHO_CDEG.start == 12
+                && field::out_point::STATUS == 14
+                && field::out_point::RESERVED == 15
+        );
+        out[..OUTPUT_POINT_LEN].copy_from_slice(&rec);
         Ok(())
     }
 }
@@ -327,7 +389,7 @@ pub(super) fn emit_output_fragment(
     seq: u32,
     header: &OutputHeaderRepr,
     first: u16,
-    point: &mut dyn FnMut(usize) -> Result<OutputPointRepr, EncodeError>,
+    mut point: impl FnMut(usize) -> Result<OutputPointRepr, EncodeError>,
     out: &mut [u8],
 ) -> Result<usize, EncodeError> {
     let line_len = usize::from(header.line_len);
@@ -567,6 +629,70 @@ mod tests {
             0,
             "failed encodes do not consume sequence numbers"
         );
+    }
+
+    #[test]
+    fn fast_rounding_is_the_general_one() {
+        // Halves, neighbours of halves, the 2^30 edge, huge, non-finite, signed zeros.
+        let mut vals = std::vec![
+            0.0f32,
+            -0.0,
+            0.5e-6,
+            -0.5e-6,
+            1.5e-6,
+            -2.5e-6,
+            1e-45,
+            -1e-45,
+            0.004_999_999,
+            0.005,
+            -0.005,
+            179.995,
+            -179.995,
+            180.0,
+            -180.0,
+            180.004,
+            1073.741_8,
+            -1073.741_8,
+            1073.741_9,
+            2147.483_5,
+            -2147.483_7,
+            3000.0,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        let mut r = 99u64;
+        for _ in 0..200_000 {
+            r = r
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let v = f32::from_bits((r >> 32) as u32);
+            vals.push(v);
+            vals.push(f32::from_bits(((r >> 40) as u32 & 0x00FF_FFFF) | 0x4000_0000) - 3.0);
+            // k + 0.5 µm exactly and one ulp either side.
+            let h = ((r >> 44) as i32 - (1 << 19)) as f32 + 0.5;
+            for w in [
+                h,
+                f32::from_bits(h.to_bits() + 1),
+                f32::from_bits(h.to_bits() - 1),
+            ] {
+                vals.push(w * 1e-6);
+                vals.push(w * 1e-2);
+            }
+        }
+        for v in vals {
+            for (scale, lo, hi) in [(1e6f32, i32::MIN, i32::MAX), (100.0, -18_000, 18_000)] {
+                let general = scale_round(v, scale, lo, hi);
+                if let Some(f) = scale_round_fast(v, 2.0 * scale) {
+                    let f = (lo..=hi).contains(&f).then_some(f);
+                    assert_eq!(f, general, "{v:e} × {scale}");
+                } else {
+                    assert!(!(v * scale).is_finite() || (v * scale).abs() >= 1073741824.0);
+                }
+            }
+        }
     }
 
     proptest! {

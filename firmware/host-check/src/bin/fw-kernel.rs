@@ -7,7 +7,7 @@
 use std::process::ExitCode;
 
 use curbtrace_core::wire::MAX_PACKET_LEN;
-use curbtrace_firmware::app::{self, Node, MAX_POINTS, RING};
+use curbtrace_firmware::app::{self, Node};
 
 /// `std::io` behind `embedded_io` (what a UART driver is on the board).
 struct Io<T>(T);
@@ -45,7 +45,7 @@ impl<T: std::io::Write> embedded_io::Write for Io<T> {
 fn run(input: &str, output: &str) -> Result<(), String> {
     let inf = std::fs::File::open(input).map_err(|e| format!("{input}: {e}"))?;
     let outf = std::fs::File::create(output).map_err(|e| format!("{output}: {e}"))?;
-    let mut node: Box<Node<RING, MAX_POINTS>> = Box::default();
+    let mut node: Box<Node> = Box::default();
     let mut packet = [0u8; MAX_PACKET_LEN];
     let sum = app::run(
         &mut node,
@@ -56,7 +56,7 @@ fn run(input: &str, output: &str) -> Result<(), String> {
     .map_err(|e| format!("{input} → {output}: {e:?}"))?;
     eprintln!(
         "fw-kernel: {} lines, {} points, {} output packets",
-        sum.lines, sum.ingest.points_in, sum.packets_out
+        sum.counters.kernel_lines, sum.counters.ingest.points_in, sum.packets_out
     );
     Ok(())
 }
