@@ -57,10 +57,10 @@ pub struct SectionReport {
     pub points_in: usize,
     /// Points after outlier removal and down-sampling.
     pub points_preprocessed: usize,
-    /// The β whose candidate set had the smallest E_s.
-    pub beta_m: Option<f64>,
-    /// (β, candidates, E_s) per refined plane.
-    pub energies: Vec<(f64, usize, Option<f64>)>,
+    /// Per side (left, right): the β whose candidate set had the smallest E_s.
+    pub beta_m: [Option<f64>; 2],
+    /// (β, candidates, E_s left, E_s right) per refined plane.
+    pub energies: Vec<(f64, usize, Option<f64>, Option<f64>)>,
     /// Candidate edge points of the chosen set.
     pub candidates: usize,
     /// The most frequent road width of the section (Eq. 3).
@@ -206,9 +206,19 @@ fn process_section(
     // §3.2.
     let pts = if params.sor_after_voxel {
         let v = preprocess::voxel_downsample(&raw, params.voxel_m);
-        preprocess::statistical_outlier_removal(&v, params.sor_k, params.sor_std_mul)
+        preprocess::statistical_outlier_removal(
+            &v,
+            params.sor_k,
+            params.sor_std_mul,
+            2.0 * params.voxel_m,
+        )
     } else {
-        let s = preprocess::statistical_outlier_removal(&raw, params.sor_k, params.sor_std_mul);
+        let s = preprocess::statistical_outlier_removal(
+            &raw,
+            params.sor_k,
+            params.sor_std_mul,
+            2.0 * params.voxel_m,
+        );
         preprocess::voxel_downsample(&s, params.voxel_m)
     };
     drop(raw);
@@ -234,6 +244,7 @@ fn process_section(
         params.neighbour_radius_m,
         params.min_candidates,
         params.energy_tolerance,
+        params.energy_slack_m,
         params.seed ^ (sec.index as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15),
         &|i| locate(i).map(|p| (p.s, p.d)),
     );
@@ -458,7 +469,7 @@ mod tests {
         assert_eq!(rep.sections.len(), 3);
         for s in &rep.sections {
             // The curb face is 150 mm: any β up to 0.08 m leaves part of it outside.
-            assert!(s.beta_m.is_some(), "{s:?}");
+            assert!(s.beta_m.iter().all(Option::is_some), "{s:?}");
             // Curb to curb: 10 m (bin [10.0, 10.1)).
             assert!((s.road_width_m.unwrap() - 10.05).abs() < 0.11, "{s:?}");
         }

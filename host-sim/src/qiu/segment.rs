@@ -175,20 +175,28 @@ pub fn candidates_on_grid(grid: &RoughGrid, rough: &[usize], is_refined: &[bool]
 /// Station bin over which the innermost candidate is taken for E_s, metres.
 const ENERGY_BIN_M: f64 = 0.5;
 
-/// The smoothness energy E_s of Eq. 2: the variance of the distances d(e_i, t_i) from
-/// candidate points to their nearest trajectory points. `pos` holds (station, signed
-/// offset) per candidate. Two readings the paper leaves open are fixed here:
+/// The smoothness energy E_s of Eq. 2 per side (left, right): the variance of the distance
+/// d(e_i, t_i) from candidate points to their nearest trajectory points. `pos` holds
+/// (station, signed offset) per candidate. The paper leaves three readings open; they are
+/// fixed here so that the energy ranks a clean edge line above road noise *reliably*:
 ///
-/// - the variance is taken per side and summed: one variance over both sides would mostly
-///   measure how far the trajectory is from the road's middle;
-/// - it is the variance of the *innermost* candidate's distance per 0.5 m of station (the
-///   point Eq. 3 pairs as well). Over all candidates, a curb with a wall behind it would
-///   score worse than the wall alone (a two-valued mixture has a larger variance than
-///   either value), so the β that loses the curb would win; innermost per station, road
-///   noise (β too small) makes the line jump and scores badly, a clean curb line scores 0.
+/// - per side: one variance over both sides would mostly measure how far the trajectory is
+///   from the road's middle (and the two sides may need different β);
+/// - of the *innermost* candidate's distance per 0.5 m of station (the point Eq. 3 pairs as
+///   well): over all candidates a curb with a wall behind it scores worse than the wall
+///   alone (a two-valued mixture has a larger variance than either value);
+/// - the variance *around the line's own course*, estimated robustly as half the median
+///   squared difference between consecutive stations (von Neumann's successive-difference
+///   estimator with a median). The plain variance about the mean was tried first and is
+///   unstable: a clean curb interrupted by curb cuts, an intersection or a widening road
+///   jumps between two or three offsets and scores 1–13 m², while road noise (β below the
+///   range noise) makes the innermost point hover near the vehicle and can score less —
+///   it did so on one of three RANSAC seeds on `sapporo`, and that one choice took
+///   completeness at 200 mm from 68 % to 39 %. Successive differences ignore a few jumps
+///   and a slow widening; noise jumps at every station.
 ///
-/// `None` when no side has two stations with candidates.
-pub fn smoothness_energy(pos: &[(f64, f64)]) -> Option<f64> {
+/// A side's energy is `None` with fewer than 3 stations holding candidates.
+pub fn smoothness_energy(pos: &[(f64, f64)]) -> [Option<f64>; 2] {
     let mut inner: [std::collections::BTreeMap<i64, f64>; 2] = Default::default();
     for &(s, d) in pos {
         let side = usize::from(d < 0.0);
@@ -197,37 +205,38 @@ pub fn smoothness_energy(pos: &[(f64, f64)]) -> Option<f64> {
             .or_insert(f64::INFINITY);
         *e = e.min(d.abs());
     }
-    let var = |m: &std::collections::BTreeMap<i64, f64>| -> Option<f64> {
-        if m.len() < 2 {
+    inner.map(|m| {
+        let v: Vec<f64> = m.values().copied().collect();
+        if v.len() < 3 {
             return None;
         }
-        let n = m.len() as f64;
-        let mean = m.values().sum::<f64>() / n;
-        Some(m.values().map(|x| (x - mean).powi(2)).sum::<f64>() / n)
-    };
-    match (var(&inner[0]), var(&inner[1])) {
-        (None, None) => None,
-        (a, b) => Some(a.unwrap_or(0.0) + b.unwrap_or(0.0)),
-    }
+        let mut d2: Vec<f64> = v.windows(2).map(|w| (w[1] - w[0]).powi(2)).collect();
+        let mid = d2.len() / 2;
+        let (_, m, _) = d2.select_nth_unstable_by(mid, f64::total_cmp);
+        Some(0.5 * *m)
+    })
 }
 
 /// The outcome of the rough segmentation of one section.
 #[derive(Clone, Debug, Default)]
 pub struct Segmentation {
-    /// Indices of the chosen candidate edge points.
+    /// Indices of the chosen candidate edge points (both sides).
     pub candidates: Vec<usize>,
-    /// The β of the chosen set, metres (`None` when no set qualified).
-    pub beta_m: Option<f64>,
-    /// (β, number of candidates, E_s) for every refined plane, for reports and tests.
-    pub energies: Vec<(f64, usize, Option<f64>)>,
+    /// The β of the chosen set per side (left, right), metres (`None` when no set
+    /// qualified).
+    pub beta_m: [Option<f64>; 2],
+    /// (β, number of candidates, E_s left, E_s right) for every refined plane, for reports
+    /// and tests.
+    pub energies: Vec<(f64, usize, Option<f64>, Option<f64>)>,
 }
 
 /// §3.3.2 as a whole on normalised points (`pts` with z replaced by height above the grid
 /// minimum). `position_of(i)` gives the station and signed offset of point `i` relative to
-/// its nearest trajectory point. Among sets with at least `min_candidates` points, the
-/// smallest β whose E_s is within `energy_tolerance` (relative) of the smallest E_s wins
-/// (with the default 0, the set with the smallest E_s as in the paper; ties go to the
-/// smaller β, which sees lower curbs).
+/// its nearest trajectory point. Per side, among sets with at least `min_candidates` points
+/// on that side, the smallest β whose E_s is within `energy_tolerance` (relative) of the
+/// smallest E_s, or whose √E_s is within `energy_slack_m` of the smallest √E_s, wins (with
+/// both 0, the set with the smallest E_s as in the paper; ties go to the smaller β, which
+/// sees lower curbs).
 #[allow(clippy::too_many_arguments)]
 pub fn rough_segmentation(
     pts: &[[f64; 3]],
@@ -238,6 +247,7 @@ pub fn rough_segmentation(
     radius: f64,
     min_candidates: usize,
     energy_tolerance: f64,
+    energy_slack_m: f64,
     seed: u64,
     position_of: &dyn Fn(usize) -> Option<(f64, f64)>,
 ) -> Segmentation {
@@ -248,14 +258,15 @@ pub fn rough_segmentation(
         return Segmentation::default();
     };
     let mut out = Segmentation::default();
-    let mut sets: Vec<(f64, f64, Vec<usize>)> = Vec::new();
+    // Per side: (E_s, β, candidates of that side).
+    let mut sets: [Vec<(f64, f64, Vec<usize>)>; 2] = Default::default();
     let grid = RoughGrid::new(pts, &rough, radius);
     let mut is_refined = vec![false; pts.len()];
     for &beta in betas {
         let Some((_, refined)) =
             ransac_plane(pts, &rough, beta, iterations, max_tilt_deg, &mut rng)
         else {
-            out.energies.push((beta, 0, None));
+            out.energies.push((beta, 0, None, None));
             continue;
         };
         is_refined.iter_mut().for_each(|f| *f = false);
@@ -263,27 +274,41 @@ pub fn rough_segmentation(
             is_refined[i] = true;
         }
         let cand = candidates_on_grid(&grid, &rough, &is_refined);
-        let pos: Vec<(f64, f64)> = cand.iter().filter_map(|&i| position_of(i)).collect();
+        let placed: Vec<(usize, (f64, f64))> = cand
+            .iter()
+            .filter_map(|&i| position_of(i).map(|p| (i, p)))
+            .collect();
+        let pos: Vec<(f64, f64)> = placed.iter().map(|x| x.1).collect();
         let e = smoothness_energy(&pos);
-        out.energies.push((beta, cand.len(), e));
-        if let Some(e) = e {
-            if cand.len() >= min_candidates {
-                sets.push((e, beta, cand));
+        out.energies.push((beta, cand.len(), e[0], e[1]));
+        for side in 0..2 {
+            let mine: Vec<usize> = placed
+                .iter()
+                .filter(|(_, p)| usize::from(p.1 < 0.0) == side)
+                .map(|x| x.0)
+                .collect();
+            if let Some(e) = e[side] {
+                if mine.len() >= min_candidates {
+                    sets[side].push((e, beta, mine));
+                }
             }
         }
     }
-    let Some(e_min) = sets.iter().map(|s| s.0).min_by(f64::total_cmp) else {
-        return out;
-    };
-    let limit = e_min * (1.0 + energy_tolerance);
-    if let Some((_, beta, cand)) = sets
-        .into_iter()
-        .filter(|s| s.0 <= limit)
-        .min_by(|a, b| a.1.total_cmp(&b.1))
-    {
-        out.beta_m = Some(beta);
-        out.candidates = cand;
+    for (side, sets) in sets.into_iter().enumerate() {
+        let Some(e_min) = sets.iter().map(|s| s.0).min_by(f64::total_cmp) else {
+            continue;
+        };
+        let limit = (e_min * (1.0 + energy_tolerance)).max((e_min.sqrt() + energy_slack_m).powi(2));
+        if let Some((_, beta, cand)) = sets
+            .into_iter()
+            .filter(|s| s.0 <= limit)
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+        {
+            out.beta_m[side] = Some(beta);
+            out.candidates.extend(cand);
+        }
     }
+    out.candidates.sort_unstable();
     out
 }
 
@@ -362,19 +387,32 @@ mod tests {
     }
 
     #[test]
-    fn smoothness_energy_is_the_per_side_variance_of_the_innermost_line() {
-        // Left innermost offsets 4 and 6 at stations 0 and 1 (variance 1), right −5 twice
-        // (variance 0): E_s = 1. The extra left point at 7 m is behind the innermost.
-        let e = smoothness_energy(&[(0.1, 4.0), (0.2, 7.0), (1.1, 6.0), (0.1, -5.0), (1.1, -5.0)]);
-        assert_eq!(e, Some(1.0));
-        // A straight curb with a wall behind it scores 0; with road noise in front, more.
-        let curb_wall: Vec<(f64, f64)> = (0..10)
+    fn smoothness_energy_is_the_robust_per_side_spread_of_the_innermost_line() {
+        // Left innermost offsets 4, 6, 4, 4 at stations 0…3 (the extra point at 7 m lies
+        // behind): squared steps 4, 4, 0 → median 4 → E_s = 2. Right: −5 three times → 0.
+        let e = smoothness_energy(&[
+            (0.1, 4.0),
+            (0.2, 7.0),
+            (1.1, 6.0),
+            (2.1, 4.0),
+            (3.1, 4.0),
+            (0.1, -5.0),
+            (1.1, -5.0),
+            (2.1, -5.0),
+        ]);
+        assert_eq!(e, [Some(2.0), Some(0.0)]);
+        // A straight curb with a wall behind it scores 0, also when a curb cut (stations
+        // 4–5) lets the innermost point jump to the wall twice.
+        let mut curb_wall: Vec<(f64, f64)> = (0..20)
             .flat_map(|k| [(k as f64, 5.0), (k as f64, 8.0)])
             .collect();
-        assert_eq!(smoothness_energy(&curb_wall), Some(0.0));
-        let mut noisy = curb_wall.clone();
-        noisy.push((3.0, 1.0));
-        assert!(smoothness_energy(&noisy).unwrap() > 1.0);
-        assert_eq!(smoothness_energy(&[(0.0, 1.0)]), None);
+        assert_eq!(smoothness_energy(&curb_wall), [Some(0.0), None]);
+        curb_wall.retain(|&(s, d)| !(d == 5.0 && (4.0..6.0).contains(&s)));
+        assert_eq!(smoothness_energy(&curb_wall), [Some(0.0), None]);
+        // Road noise hovering near the vehicle (offsets alternating 1 and 2 m) scores far
+        // worse, though its plain variance (0.25) is below the curb-with-cut's (1.6).
+        let noise: Vec<(f64, f64)> = (0..20).map(|k| (k as f64, 1.0 + (k % 2) as f64)).collect();
+        assert_eq!(smoothness_energy(&noise), [Some(0.5), None]);
+        assert_eq!(smoothness_energy(&[(0.0, 1.0), (1.0, 1.0)]), [None, None]);
     }
 }
