@@ -235,13 +235,16 @@ fn process_section(
     // §3.3.2.
     let track = SectionTrack::new(traj, st, sec.t_start - TRACK_PAD_S, sec.t_end + TRACK_PAD_S);
     let locate = |i: usize| track.locate(pts[i][0] + o[0], pts[i][1] + o[1]);
+    let z_abs: Vec<f64> = pts.iter().map(|p| p[2]).collect();
     let seg = segment::rough_segmentation(
         &pts_norm,
+        &z_abs,
         params.alpha_m,
         &params.betas_m,
         params.ransac_iterations,
         params.ransac_max_tilt_deg,
         params.neighbour_radius_m,
+        params.min_rise_beta,
         params.min_candidates,
         params.energy_tolerance,
         params.energy_slack_m,

@@ -73,6 +73,11 @@ pub struct QiuParams {
     /// the paper: 0.1 m, two voxels, so only the lower curb face next to the road
     /// qualifies, not the curb top.
     pub neighbour_radius_m: f64,
+    /// The inlier next to a candidate must lie at least `min_rise_beta`·β lower before
+    /// normalisation (see `segment::candidate_edge_points`): an edge stands above the
+    /// pavement beside it. Not in the paper (0 gives its plain rule); 1.0 asks of the
+    /// un-normalised heights what the refined plane asks of the normalised ones.
+    pub min_rise_beta: f64,
     /// A candidate set (one per β) with fewer points than this on both sides together is
     /// not considered when choosing by E_s (a near-empty set would have a meaningless
     /// variance). Not in the paper.
@@ -167,6 +172,7 @@ impl Default for QiuParams {
             ransac_max_tilt_deg: 20.0,
             seed: 2016,
             neighbour_radius_m: 0.1,
+            min_rise_beta: 1.0,
             min_candidates: 30,
             energy_tolerance: 0.0,
             energy_slack_m: 0.02,
@@ -232,6 +238,7 @@ impl QiuParams {
             ("energy_tolerance", self.energy_tolerance),
             ("energy_slack_m", self.energy_slack_m),
             ("min_step_m", self.min_step_m),
+            ("min_rise_beta", self.min_rise_beta),
         ];
         for (name, v) in nonneg {
             if !(v.is_finite() && v >= 0.0) {

@@ -99,14 +99,30 @@ pub fn ransac_plane(
 /// "We search inliers near an outlier. If there exist an inlier, then the outlier is
 /// considered to be a road edge point" (§3.3.2): of the points `rough` (the rough plane),
 /// those not in the refined plane (`is_refined[i] == false`) with a refined-plane point
-/// within `radius` (3D). Returns indices into `pts`, in `rough` order.
+/// within `radius` (3D) that lies at least `min_rise` metres lower in the *un-normalised*
+/// heights `z_abs` (0 gives the paper's plain rule). Returns indices into `pts`, in `rough`
+/// order.
+///
+/// Why the rise: the grid minimum of §3.3.1 sets every cell that lies wholly on a sidewalk
+/// to height 0, so sidewalk points there become refined-plane inliers, and the curb top in
+/// the neighbouring cell (which holds the toe, and so the road's minimum) becomes an outlier
+/// next to them — a false candidate up to one cell (0.5 m) behind the toe. An edge stands
+/// *above* the pavement beside it; those points are level with their neighbour.
 pub fn candidate_edge_points(
     pts: &[[f64; 3]],
+    z_abs: &[f64],
     rough: &[usize],
     is_refined: &[bool],
     radius: f64,
+    min_rise: f64,
 ) -> Vec<usize> {
-    candidates_on_grid(&RoughGrid::new(pts, rough, radius), rough, is_refined)
+    candidates_on_grid(
+        &RoughGrid::new(pts, rough, radius),
+        z_abs,
+        rough,
+        is_refined,
+        min_rise,
+    )
 }
 
 /// The rough plane's points hashed on cubes of the search radius, built once per section
@@ -137,7 +153,13 @@ impl<'a> RoughGrid<'a> {
 }
 
 /// [`candidate_edge_points`] on a prebuilt grid.
-pub fn candidates_on_grid(grid: &RoughGrid, rough: &[usize], is_refined: &[bool]) -> Vec<usize> {
+pub fn candidates_on_grid(
+    grid: &RoughGrid,
+    z_abs: &[f64],
+    rough: &[usize],
+    is_refined: &[bool],
+    min_rise: f64,
+) -> Vec<usize> {
     let (pts, radius) = (grid.pts, grid.radius);
     let key = |p: &[f64; 3]| RoughGrid::key(p, radius);
     let r2 = radius * radius;
@@ -153,7 +175,7 @@ pub fn candidates_on_grid(grid: &RoughGrid, rough: &[usize], is_refined: &[bool]
                     for dz in -1..=1 {
                         if let Some(cell) = grid.cells.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
                             if cell.iter().any(|&j| {
-                                is_refined[j] && {
+                                is_refined[j] && z_abs[i] - z_abs[j] >= min_rise && {
                                     let q = &pts[j];
                                     (q[0] - p[0]).powi(2)
                                         + (q[1] - p[1]).powi(2)
@@ -231,7 +253,8 @@ pub struct Segmentation {
 }
 
 /// §3.3.2 as a whole on normalised points (`pts` with z replaced by height above the grid
-/// minimum). `position_of(i)` gives the station and signed offset of point `i` relative to
+/// minimum; `z_abs` the heights before normalisation, see [`candidate_edge_points`] with
+/// `min_rise` = `min_rise_beta`·β). `position_of(i)` gives the station and signed offset of point `i` relative to
 /// its nearest trajectory point. Per side, among sets with at least `min_candidates` points
 /// on that side, the smallest β whose E_s is within `energy_tolerance` (relative) of the
 /// smallest E_s, or whose √E_s is within `energy_slack_m` of the smallest √E_s, wins (with
@@ -240,11 +263,13 @@ pub struct Segmentation {
 #[allow(clippy::too_many_arguments)]
 pub fn rough_segmentation(
     pts: &[[f64; 3]],
+    z_abs: &[f64],
     alpha: f64,
     betas: &[f64],
     iterations: usize,
     max_tilt_deg: f64,
     radius: f64,
+    min_rise_beta: f64,
     min_candidates: usize,
     energy_tolerance: f64,
     energy_slack_m: f64,
@@ -273,7 +298,7 @@ pub fn rough_segmentation(
         for &i in &refined {
             is_refined[i] = true;
         }
-        let cand = candidates_on_grid(&grid, &rough, &is_refined);
+        let cand = candidates_on_grid(&grid, z_abs, &rough, &is_refined, min_rise_beta * beta);
         let placed: Vec<(usize, (f64, f64))> = cand
             .iter()
             .filter_map(|&i| position_of(i).map(|p| (i, p)))
@@ -382,8 +407,28 @@ mod tests {
         ];
         let rough = [0, 1, 2, 3, 4];
         let refined = [true, true, true, false, false];
-        assert_eq!(candidate_edge_points(&pts, &rough, &refined, 0.1), vec![3]);
-        assert!(candidate_edge_points(&pts, &rough, &refined, 0.05).is_empty());
+        let z: Vec<f64> = pts.iter().map(|p| p[2]).collect();
+        assert_eq!(
+            candidate_edge_points(&pts, &z, &rough, &refined, 0.1, 0.0),
+            vec![3]
+        );
+        assert!(candidate_edge_points(&pts, &z, &rough, &refined, 0.05, 0.0).is_empty());
+        // It rises 0.05 m above its neighbour: a candidate up to min_rise = 0.05 m.
+        assert_eq!(
+            candidate_edge_points(&pts, &z, &rough, &refined, 0.1, 0.05),
+            vec![3]
+        );
+        // The curb top beside a sidewalk cell: normalised, the sidewalk point (index 1) is
+        // at 0 and the top (index 0) 0.08 m above it, 0.06 m away; un-normalised both are
+        // at the sidewalk's 0.08 m, so with a rise required it is no candidate.
+        let pts = [[0.0, 0.0, 0.08], [0.06, 0.0, 0.0]];
+        let z = [0.08, 0.08];
+        let (rough, refined) = ([0, 1], [false, true]);
+        assert_eq!(
+            candidate_edge_points(&pts, &z, &rough, &refined, 0.1, 0.0),
+            vec![0]
+        );
+        assert!(candidate_edge_points(&pts, &z, &rough, &refined, 0.1, 0.02).is_empty());
     }
 
     #[test]
