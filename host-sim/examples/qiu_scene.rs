@@ -153,6 +153,17 @@ fn main() -> anyhow::Result<()> {
             ev.to_markdown()
         );
     }
+    if let Ok(dir) = std::env::var("QIU_PLOT") {
+        plot_windows(
+            std::path::Path::new(&dir),
+            &x,
+            &y,
+            &z,
+            &reference,
+            &lines,
+            &report,
+        )?;
+    }
     let out = out.or_else(|| from_files.then(|| dir_in.to_path_buf()));
     if let Some(dir) = out {
         std::fs::create_dir_all(&dir)?;
@@ -160,6 +171,56 @@ fn main() -> anyhow::Result<()> {
         if !from_files {
             write_geojson(&dir.join("reference.geojson"), &reference, crs.as_ref())?;
         }
+    }
+    Ok(())
+}
+
+/// `QIU_PLOT=DIR`: top views of every intersection, bus bay, curb cut and gap, with the
+/// candidates kept by the width step drawn as short dashes beside the output lines.
+fn plot_windows(
+    dir: &std::path::Path,
+    x: &[f64],
+    y: &[f64],
+    z: &[f64],
+    reference: &[curbtrace_host_sim::model::EdgeLine],
+    lines: &[curbtrace_host_sim::model::EdgeLine],
+    report: &curbtrace_host_sim::qiu::QiuReport,
+) -> anyhow::Result<()> {
+    use curbtrace_host_sim::model::EdgeLine;
+    use curbtrace_host_sim::plot::{top_view_png, Cloud, TopView, Window};
+    std::fs::create_dir_all(dir)?;
+    let mut drawn: Vec<EdgeLine> = lines.to_vec();
+    for s in &report.sections {
+        for (p, kept) in &s.candidate_points {
+            let d = if *kept { 0.06 } else { 0.02 };
+            let mut l = lines
+                .first()
+                .cloned()
+                .unwrap_or_else(|| reference[0].clone());
+            l.points = vec![*p, [p[0] + d, p[1] + d, p[2]]];
+            drawn.push(l);
+        }
+    }
+    let mut wins: Vec<(String, Window)> = Vec::new();
+    for (k, r) in reference.iter().enumerate() {
+        if r.category.is_some_and(|c| c.as_str() != "curb") {
+            let m = r.points[r.points.len() / 2];
+            wins.push((
+                format!("{k}_{}", r.category.unwrap().as_str()),
+                Window {
+                    center: [m[0], m[1]],
+                    half_size_m: 12.0,
+                },
+            ));
+        }
+    }
+    let cloud = Cloud { x, y, z };
+    for (name, w) in wins {
+        let mut v = TopView::new(name.clone(), cloud, reference, &drawn);
+        v.window = Some(w);
+        v.max_points = 150_000;
+        v.width_px = 1000;
+        top_view_png(&dir.join(format!("{name}.png")), &v)?;
     }
     Ok(())
 }

@@ -69,6 +69,9 @@ pub struct SectionReport {
     pub width_kept: usize,
     /// Chains kept by the continuity refinement (before clipping to the core).
     pub chains: usize,
+    /// The chosen candidates (world x, y, terrain z) and whether the road-width refinement
+    /// kept them, for plots.
+    pub candidate_points: Vec<([f64; 3], bool)>,
     /// Wall seconds per stage: partition (§3.1), pre-processing (§3.2), normalisation
     /// (§3.3.1), rough segmentation (§3.3.2), refinement and heights (§3.4).
     pub stage_s: [f64; 5],
@@ -136,7 +139,10 @@ pub fn extract_edges_with_report(
         pieces.extend(chains);
         report.sections.push(rep);
     }
-    let chains = refine::keep_longest(refine::join_chains(pieces, params), params);
+    // The joined chains again: a join across sections must not bring back an obstacle.
+    let mut chains = refine::join_chains(pieces, params);
+    chains.retain(|c| is_edge_step(c, params));
+    let chains = refine::keep_longest(chains, params);
     let lines = chains
         .into_iter()
         .map(|c| {
@@ -160,6 +166,11 @@ pub fn extract_edges_with_report(
         })
         .collect();
     (lines, report)
+}
+
+/// A road edge has ground on both sides and a step between `min_step_m` and `max_step_m`.
+fn is_edge_step(c: &Chain, params: &QiuParams) -> bool {
+    refine::median_step(c).is_some_and(|h| (params.min_step_m..=params.max_step_m).contains(&h))
 }
 
 /// Seconds of trajectory added before and after a section for nearest-trajectory-point
@@ -272,13 +283,22 @@ fn process_section(
     let width = refine::refine_by_width(&edge_pts, params);
     rep.road_width_m = width.road_width_m;
     rep.width_kept = width.kept.len();
+    let mut kept_flag = vec![false; edge_pts.len()];
+    for &i in &width.kept {
+        kept_flag[i] = true;
+    }
+    rep.candidate_points = edge_pts
+        .iter()
+        .zip(kept_flag)
+        .map(|(e, k)| (e.p, k))
+        .collect();
     let mut chains = refine::refine_by_continuity(&edge_pts, &width.kept, params);
     let grid = HeightGrid::new(&pts, o);
     for c in &mut chains {
         grid.measure_steps(c, params.height_band_m);
     }
     // Ground on both sides (see `QiuParams::min_step_m`), then §3.4.2 step 4.
-    chains.retain(|c| refine::median_step(c).is_some_and(|h| h >= params.min_step_m));
+    chains.retain(|c| is_edge_step(c, params));
     let chains = refine::keep_longest(chains, params);
     rep.chains = chains.len();
     let clipped: Vec<Chain> = chains

@@ -100,6 +100,12 @@ pub struct QiuParams {
     /// chosen, metres. Not in the paper (its scenes are judged by eye); 0.02 m keeps curb
     /// cuts (20–30 mm) that were joined into a curb chain.
     pub min_step_m: f64,
+    /// A chain whose median height step is above this is an obstacle's foot — a parked
+    /// car's side, a wall, a fence — not a road edge, and is dropped like one below
+    /// `min_step_m`, metres. Not in the paper (its parked cars are left to the width step,
+    /// §4.3 Urban 3). 0.5 m: above any curb (100–250 mm, 300 mm at most), below a car
+    /// body's side seen across its foot (0.5–1.5 m).
+    pub max_step_m: f64,
 
     // --- §3.4.1 refinement by road width -------------------------------------------------
     /// Eq. 3: R_i must lie within this distance of the line L_i P_i, metres. Not in the
@@ -177,6 +183,7 @@ impl Default for QiuParams {
             energy_tolerance: 0.0,
             energy_slack_m: 0.02,
             min_step_m: 0.02,
+            max_step_m: 0.5,
             width_pair_m: 0.25,
             width_bin_m: 0.1,
             width_tolerance_m: 0.3,
@@ -238,6 +245,7 @@ impl QiuParams {
             ("energy_tolerance", self.energy_tolerance),
             ("energy_slack_m", self.energy_slack_m),
             ("min_step_m", self.min_step_m),
+            ("max_step_m", self.max_step_m),
             ("min_rise_beta", self.min_rise_beta),
         ];
         for (name, v) in nonneg {
@@ -246,6 +254,12 @@ impl QiuParams {
                     "{name} must be zero or more, found {v}"
                 )));
             }
+        }
+        if !(self.max_step_m >= self.min_step_m) {
+            return Err(QiuParamsError(format!(
+                "max_step_m must be at least min_step_m ({}), found {}",
+                self.min_step_m, self.max_step_m
+            )));
         }
         if !(self.section_overlap_m >= 0.0 && self.section_overlap_m < self.section_length_m) {
             return Err(QiuParamsError(format!(
