@@ -57,10 +57,10 @@ pub struct SectionReport {
     pub points_in: usize,
     /// Points after outlier removal and down-sampling.
     pub points_preprocessed: usize,
-    /// The β whose candidate set had the smallest E_s.
-    pub beta_m: Option<f64>,
-    /// (β, candidates, E_s) per refined plane.
-    pub energies: Vec<(f64, usize, Option<f64>)>,
+    /// Per side (left, right): the β whose candidate set had the smallest E_s.
+    pub beta_m: [Option<f64>; 2],
+    /// (β, candidates, E_s left, E_s right) per refined plane.
+    pub energies: Vec<(f64, usize, Option<f64>, Option<f64>)>,
     /// Candidate edge points of the chosen set.
     pub candidates: usize,
     /// The most frequent road width of the section (Eq. 3).
@@ -69,6 +69,9 @@ pub struct SectionReport {
     pub width_kept: usize,
     /// Chains kept by the continuity refinement (before clipping to the core).
     pub chains: usize,
+    /// The chosen candidates (world x, y, terrain z) and whether the road-width refinement
+    /// kept them, for plots.
+    pub candidate_points: Vec<([f64; 3], bool)>,
     /// Wall seconds per stage: partition (§3.1), pre-processing (§3.2), normalisation
     /// (§3.3.1), rough segmentation (§3.3.2), refinement and heights (§3.4).
     pub stage_s: [f64; 5],
@@ -136,7 +139,10 @@ pub fn extract_edges_with_report(
         pieces.extend(chains);
         report.sections.push(rep);
     }
-    let chains = refine::keep_longest(refine::join_chains(pieces, params), params);
+    // The joined chains again: a join across sections must not bring back an obstacle.
+    let mut chains = refine::join_chains(pieces, params);
+    chains.retain(|c| is_edge_step(c, params));
+    let chains = refine::keep_longest(chains, params);
     let lines = chains
         .into_iter()
         .map(|c| {
@@ -160,6 +166,11 @@ pub fn extract_edges_with_report(
         })
         .collect();
     (lines, report)
+}
+
+/// A road edge has ground on both sides and a step between `min_step_m` and `max_step_m`.
+fn is_edge_step(c: &Chain, params: &QiuParams) -> bool {
+    refine::median_step(c).is_some_and(|h| (params.min_step_m..=params.max_step_m).contains(&h))
 }
 
 /// Seconds of trajectory added before and after a section for nearest-trajectory-point
@@ -206,9 +217,19 @@ fn process_section(
     // §3.2.
     let pts = if params.sor_after_voxel {
         let v = preprocess::voxel_downsample(&raw, params.voxel_m);
-        preprocess::statistical_outlier_removal(&v, params.sor_k, params.sor_std_mul)
+        preprocess::statistical_outlier_removal(
+            &v,
+            params.sor_k,
+            params.sor_std_mul,
+            2.0 * params.voxel_m,
+        )
     } else {
-        let s = preprocess::statistical_outlier_removal(&raw, params.sor_k, params.sor_std_mul);
+        let s = preprocess::statistical_outlier_removal(
+            &raw,
+            params.sor_k,
+            params.sor_std_mul,
+            2.0 * params.voxel_m,
+        );
         preprocess::voxel_downsample(&s, params.voxel_m)
     };
     drop(raw);
@@ -225,15 +246,19 @@ fn process_section(
     // §3.3.2.
     let track = SectionTrack::new(traj, st, sec.t_start - TRACK_PAD_S, sec.t_end + TRACK_PAD_S);
     let locate = |i: usize| track.locate(pts[i][0] + o[0], pts[i][1] + o[1]);
+    let z_abs: Vec<f64> = pts.iter().map(|p| p[2]).collect();
     let seg = segment::rough_segmentation(
         &pts_norm,
+        &z_abs,
         params.alpha_m,
         &params.betas_m,
         params.ransac_iterations,
         params.ransac_max_tilt_deg,
         params.neighbour_radius_m,
+        params.min_rise_beta,
         params.min_candidates,
         params.energy_tolerance,
+        params.energy_slack_m,
         params.seed ^ (sec.index as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15),
         &|i| locate(i).map(|p| (p.s, p.d)),
     );
@@ -258,13 +283,22 @@ fn process_section(
     let width = refine::refine_by_width(&edge_pts, params);
     rep.road_width_m = width.road_width_m;
     rep.width_kept = width.kept.len();
+    let mut kept_flag = vec![false; edge_pts.len()];
+    for &i in &width.kept {
+        kept_flag[i] = true;
+    }
+    rep.candidate_points = edge_pts
+        .iter()
+        .zip(kept_flag)
+        .map(|(e, k)| (e.p, k))
+        .collect();
     let mut chains = refine::refine_by_continuity(&edge_pts, &width.kept, params);
     let grid = HeightGrid::new(&pts, o);
     for c in &mut chains {
         grid.measure_steps(c, params.height_band_m);
     }
     // Ground on both sides (see `QiuParams::min_step_m`), then §3.4.2 step 4.
-    chains.retain(|c| refine::median_step(c).is_some_and(|h| h >= params.min_step_m));
+    chains.retain(|c| is_edge_step(c, params));
     let chains = refine::keep_longest(chains, params);
     rep.chains = chains.len();
     let clipped: Vec<Chain> = chains
@@ -458,7 +492,7 @@ mod tests {
         assert_eq!(rep.sections.len(), 3);
         for s in &rep.sections {
             // The curb face is 150 mm: any β up to 0.08 m leaves part of it outside.
-            assert!(s.beta_m.is_some(), "{s:?}");
+            assert!(s.beta_m.iter().all(Option::is_some), "{s:?}");
             // Curb to curb: 10 m (bin [10.0, 10.1)).
             assert!((s.road_width_m.unwrap() - 10.05).abs() < 0.11, "{s:?}");
         }

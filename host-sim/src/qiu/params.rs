@@ -73,6 +73,11 @@ pub struct QiuParams {
     /// the paper: 0.1 m, two voxels, so only the lower curb face next to the road
     /// qualifies, not the curb top.
     pub neighbour_radius_m: f64,
+    /// The inlier next to a candidate must lie at least `min_rise_beta`·β lower before
+    /// normalisation (see `segment::candidate_edge_points`): an edge stands above the
+    /// pavement beside it. Not in the paper (0 gives its plain rule); 1.0 asks of the
+    /// un-normalised heights what the refined plane asks of the normalised ones.
+    pub min_rise_beta: f64,
     /// A candidate set (one per β) with fewer points than this on both sides together is
     /// not considered when choosing by E_s (a near-empty set would have a meaningless
     /// variance). Not in the paper.
@@ -81,12 +86,26 @@ pub struct QiuParams {
     /// wins. The paper takes the smallest E_s (0, the default); a tolerance was tried on
     /// `sapporo` and let road noise (β = 0.01 m) win, so it stays off.
     pub energy_tolerance: f64,
+    /// Also within reach of the smallest E_s: sets whose √E_s (a spread in metres) is at
+    /// most this much above the smallest √E_s; of those the smallest β wins. Not in the
+    /// paper. A clean edge line's spread is at the level of the voxel (a few millimetres);
+    /// road noise (β below the range noise) gives 0.1 m and more; so 0.02 m treats every
+    /// clean line as equally smooth and lets the smallest β — the one that still sees a
+    /// low curb — win, instead of a coin toss between spreads of 2 and 3 mm that on
+    /// `sapporo` picked β = 0.07 m against an 80 mm curb.
+    pub energy_slack_m: f64,
     /// A road edge has ground on both sides: a chain whose median height step across it
     /// cannot be measured (fewer than 3 points within `height_band_m` on one side, as at
     /// the foot of a wall) or is below this is dropped before the longest chains are
     /// chosen, metres. Not in the paper (its scenes are judged by eye); 0.02 m keeps curb
     /// cuts (20–30 mm) that were joined into a curb chain.
     pub min_step_m: f64,
+    /// A chain whose median height step is above this is an obstacle's foot — a parked
+    /// car's side, a wall, a fence — not a road edge, and is dropped like one below
+    /// `min_step_m`, metres. Not in the paper (its parked cars are left to the width step,
+    /// §4.3 Urban 3). 0.5 m: above any curb (100–250 mm, 300 mm at most), below a car
+    /// body's side seen across its foot (0.5–1.5 m).
+    pub max_step_m: f64,
 
     // --- §3.4.1 refinement by road width -------------------------------------------------
     /// Eq. 3: R_i must lie within this distance of the line L_i P_i, metres. Not in the
@@ -159,9 +178,12 @@ impl Default for QiuParams {
             ransac_max_tilt_deg: 20.0,
             seed: 2016,
             neighbour_radius_m: 0.1,
+            min_rise_beta: 1.0,
             min_candidates: 30,
             energy_tolerance: 0.0,
+            energy_slack_m: 0.02,
             min_step_m: 0.02,
+            max_step_m: 0.5,
             width_pair_m: 0.25,
             width_bin_m: 0.1,
             width_tolerance_m: 0.3,
@@ -221,7 +243,10 @@ impl QiuParams {
             ("min_chain_m", self.min_chain_m),
             ("ransac_max_tilt_deg", self.ransac_max_tilt_deg),
             ("energy_tolerance", self.energy_tolerance),
+            ("energy_slack_m", self.energy_slack_m),
             ("min_step_m", self.min_step_m),
+            ("max_step_m", self.max_step_m),
+            ("min_rise_beta", self.min_rise_beta),
         ];
         for (name, v) in nonneg {
             if !(v.is_finite() && v >= 0.0) {
@@ -229,6 +254,12 @@ impl QiuParams {
                     "{name} must be zero or more, found {v}"
                 )));
             }
+        }
+        if !(self.max_step_m >= self.min_step_m) {
+            return Err(QiuParamsError(format!(
+                "max_step_m must be at least min_step_m ({}), found {}",
+                self.min_step_m, self.max_step_m
+            )));
         }
         if !(self.section_overlap_m >= 0.0 && self.section_overlap_m < self.section_length_m) {
             return Err(QiuParamsError(format!(

@@ -469,7 +469,12 @@ pub fn clip_to_stations(c: &Chain, a: f64, b: f64) -> Vec<Chain> {
                 p[2] + w * (q[2] - p[2]),
             ],
             c.s[i] + w * (c.s[j] - c.s[i]),
-            c.h[i] + w * (c.h[j] - c.h[i]),
+            // A step known at one end only is carried over, not lost to NaN.
+            match (c.h[i].is_finite(), c.h[j].is_finite()) {
+                (true, true) => c.h[i] + w * (c.h[j] - c.h[i]),
+                (true, false) => c.h[i],
+                (false, _) => c.h[j],
+            },
         )
     };
     let inside = |s: f64| s >= a && s <= b;
