@@ -389,6 +389,14 @@ pub fn profile_toe(
     );
     const MIN_SIDE: usize = 4;
     if prof.len() < 2 * MIN_SIDE {
+        if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
+            eprintln!(
+                "PROF {:.2} {:.2} m={} few",
+                centre[0],
+                centre[1],
+                prof.len()
+            );
+        }
         return None;
     }
     prof.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
@@ -506,6 +514,23 @@ pub fn profile_toe(
 /// to follow a 4 m corner radius).
 const TURN_EMA: f64 = 0.2;
 
+/// Largest vertical component of the search direction (a grade of about 15 %).
+const MAX_CLIMB: f64 = 0.15;
+
+/// `v` (a unit vector) with its vertical component clamped to ±[`MAX_CLIMB`], keeping its
+/// horizontal direction.
+fn clamp_climb(v: [f64; 3]) -> [f64; 3] {
+    if v[2].abs() <= MAX_CLIMB {
+        return v;
+    }
+    let h = v[0].hypot(v[1]);
+    if h < 1e-9 {
+        return v;
+    }
+    let k = (1.0 - MAX_CLIMB * MAX_CLIMB).sqrt() / h;
+    [v[0] * k, v[1] * k, MAX_CLIMB.copysign(v[2])]
+}
+
 fn unit3(v: [f64; 3]) -> Option<[f64; 3]> {
     let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     (l > 1e-9).then(|| [v[0] / l, v[1] / l, v[2] / l])
@@ -585,7 +610,10 @@ fn track_one_way(
             // the toe; optionally bridge a few empty or weak steps.
             let along = [vh[0] / vh_len, vh[1] / vh_len];
             let found = if params.profile_fallback && *next_virtual < u32::MAX {
-                profile_toe(input, grid, pred, along, up, params)
+                // Heights are gated around the last vertex's, not the prediction's: a few
+                // steps climbing a curb face tilt v upwards, and the profile must still
+                // see the road.
+                profile_toe(input, grid, [pred[0], pred[1], cur[2]], along, up, params)
             } else {
                 None
             };
@@ -602,7 +630,12 @@ fn track_one_way(
                     v = [c * v[0] - sn * v[1], sn * v[0] + c * v[1], v[2]];
                     continue;
                 }
-                None => break,
+                None => {
+                    if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
+                        eprintln!("STOP {} {:.3} {:.3}", own, cur[0], cur[1]);
+                    }
+                    break;
+                }
             }
         } else {
             // μ_ρ, σ_ρ over S (Eq. 5).
@@ -643,6 +676,17 @@ fn track_one_way(
             (n as u32, [input.x[n], input.y[n], input.z[n]])
         };
         let (n, p) = next;
+        if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
+            eprintln!(
+                "STEP {} {:.3} {:.3} {:.3} virt={} gap={}",
+                own,
+                p[0],
+                p[1],
+                p[2],
+                n as usize >= input.x.len(),
+                gap
+            );
+        }
         if let Some(j) = claims.near(n, p[0], p[1], own) {
             return (picked, Some(j));
         }
@@ -656,6 +700,10 @@ fn track_one_way(
             params.a * u[2] + params.b * prev_u[2],
         ])
         .unwrap_or(u);
+        // Roads climb at most a few per cent: a steeper v comes from points picked on a
+        // curb face, and would lift the search position off the ground within a few gap
+        // steps.
+        let v_new = clamp_climb(v_new);
         if gap == 0 {
             let dturn =
                 (v[0] * v_new[1] - v[1] * v_new[0]).atan2(v[0] * v_new[0] + v[1] * v_new[1]);
