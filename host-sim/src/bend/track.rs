@@ -718,3 +718,185 @@ fn track_one_way(
     }
     (picked, None)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::trajectory::Trajectory;
+
+    /// A street corner seen by scanlines across x (one every 0.11 m, points every 2 cm
+    /// along y): the main curb along y = 5 up to x = 7, a quarter circle of radius 3 about
+    /// (7, 8), then the side street's curb along x = 10 from y = 8 to y = 14. The sidewalk
+    /// is 0.15 m up. ρ = 60° · |t_x| at the last road point before each rise along a
+    /// scanline (t: the curb's unit tangent), so it fades as the corner turns to run along
+    /// the scanlines, and is 0 on the side street, which no scanline crosses.
+    struct Corner {
+        x: Vec<f64>,
+        y: Vec<f64>,
+        z: Vec<f64>,
+        t: Vec<f64>,
+        rho: Vec<f32>,
+        status: Vec<u8>,
+        scanline: Vec<u32>,
+        traj: Trajectory,
+    }
+
+    fn sidewalk(x: f64, y: f64) -> bool {
+        let fillet = x > 7.0 && y < 8.0 && (x - 7.0).powi(2) + (y - 8.0).powi(2) > 9.0;
+        y > 5.0 && x < 10.0 && !fillet
+    }
+
+    /// Distance from (x, y) to the toe line.
+    fn toe_dist(x: f64, y: f64) -> f64 {
+        if x <= 7.0 {
+            (y - 5.0).abs()
+        } else if y >= 8.0 {
+            (x - 10.0).abs()
+        } else {
+            ((x - 7.0).hypot(y - 8.0) - 3.0).abs()
+        }
+    }
+
+    fn corner() -> Corner {
+        let mut c = Corner {
+            x: Vec::new(),
+            y: Vec::new(),
+            z: Vec::new(),
+            t: Vec::new(),
+            rho: Vec::new(),
+            status: Vec::new(),
+            scanline: Vec::new(),
+            traj: Trajectory::default(),
+        };
+        let mut line = 0u32;
+        let mut x = 0.013;
+        while x < 16.0 {
+            let mut y = 0.0;
+            while y < 16.0 {
+                let up = sidewalk(x, y);
+                let next_up = sidewalk(x, y + 0.02);
+                let rho = if !up && next_up {
+                    // The curb's tangent where this scanline meets it.
+                    let tx = if x <= 7.0 {
+                        1.0
+                    } else {
+                        (y + 0.02 - 8.0).abs() / 3.0
+                    };
+                    60.0 * tx
+                } else {
+                    0.0
+                };
+                c.x.push(x);
+                c.y.push(y);
+                c.z.push(if up { 0.15 } else { 0.0 });
+                c.t.push(line as f64 * 0.01 + y * 1e-5);
+                c.rho.push(rho as f32);
+                c.status.push(STATUS_KEPT);
+                c.scanline.push(line);
+                y += 0.02;
+            }
+            x += 0.11;
+            line += 1;
+        }
+        c
+    }
+
+    fn input(c: &Corner) -> BendInput<'_> {
+        BendInput {
+            x: &c.x,
+            y: &c.y,
+            z: &c.z,
+            t: &c.t,
+            rho_deg: &c.rho,
+            status: &c.status,
+            scanline: &c.scanline,
+            candidates: &[],
+            trajectory: &c.traj,
+        }
+    }
+
+    /// The track from a seed on the main curb at x ≈ 3.
+    fn track(c: &Corner, params: &BendParams) -> Track {
+        let inp = input(c);
+        let grid = PointGrid::build(inp.x, inp.y, 0.1, |_| true);
+        let seed = (0..c.x.len())
+            .filter(|&i| c.rho[i] > 30.0)
+            .min_by(|&a, &b| (c.x[a] - 3.0).abs().total_cmp(&(c.x[b] - 3.0).abs()))
+            .unwrap();
+        let seeds = [Seed {
+            point: seed as u32,
+            side: Side::Left,
+            dir: [1.0, 0.0],
+            interval: 0,
+            inlier_ratio: 1.0,
+        }];
+        let mut tracks = track_edges(&inp, &grid, &seeds, params);
+        assert_eq!(tracks.len(), 1);
+        tracks.remove(0)
+    }
+
+    #[test]
+    fn the_track_follows_a_corner_into_the_side_street() {
+        let c = corner();
+        let params = BendParams::default();
+        let t = track(&c, &params);
+        assert_eq!(t.points.len(), t.xyz.len());
+        // Every vertex on the toe: measured ones within the 2 cm point spacing, virtual
+        // ones within half the 0.11 m scanline spacing.
+        for q in &t.xyz {
+            assert!(toe_dist(q[0], q[1]) < 0.06, "vertex {q:?} off the toe");
+        }
+        // Along the side street to within a profile length of its end (y = 14).
+        let far = t.xyz.iter().map(|q| q[1]).fold(f64::MIN, f64::max);
+        assert!(far > 13.3, "stopped at y = {far}");
+        // The side street's vertices are virtual ones (ids past the points).
+        let n = c.x.len() as u32;
+        assert!(t
+            .points
+            .iter()
+            .zip(&t.xyz)
+            .filter(|(_, q)| q[1] > 9.0)
+            .all(|(&p, _)| p >= n));
+        // Without the virtual profile the track stops where ρ fades in the corner.
+        let off = BendParams {
+            profile_fallback: false,
+            ..BendParams::default()
+        };
+        let t0 = track(&c, &off);
+        let far0 = t0.xyz.iter().map(|q| q[1]).fold(f64::MIN, f64::max);
+        assert!(far0 < 9.0, "without profiles: y = {far0}");
+    }
+
+    #[test]
+    fn profile_finds_a_step_between_scanlines_and_rejects_a_ramp() {
+        let c = corner();
+        let inp = input(&c);
+        let grid = PointGrid::build(inp.x, inp.y, 0.1, |_| true);
+        let params = BendParams::default();
+        // Across the side street's curb (x = 10) at y = 11, walking north: the curb rises
+        // on the left (towards −x).
+        let toe =
+            profile_toe(&inp, &grid, [10.1, 11.0, 0.0], [0.0, 1.0], 1.0, &params).expect("a toe");
+        assert!((toe.xyz[0] - 10.0).abs() < 0.06, "{toe:?}");
+        assert!((toe.step_m - 0.15).abs() < 0.01, "{toe:?}");
+        // With the wrong side up there is no curb (the ground falls).
+        assert!(profile_toe(&inp, &grid, [10.1, 11.0, 0.0], [0.0, 1.0], -1.0, &params).is_none());
+        // A flat road gives nothing.
+        assert!(profile_toe(&inp, &grid, [13.0, 2.0, 0.0], [0.0, 1.0], 1.0, &params).is_none());
+        // A 20 % ramp (z = 0.2·x) is no step.
+        let ramp_z: Vec<f64> = c.x.iter().map(|&x| 0.2 * x).collect();
+        let ramp = BendInput {
+            z: &ramp_z,
+            ..input(&c)
+        };
+        assert!(profile_toe(&ramp, &grid, [13.0, 2.0, 2.6], [0.0, 1.0], 1.0, &params).is_none());
+    }
+
+    #[test]
+    fn climb_is_clamped_and_flat_directions_kept() {
+        let v = clamp_climb([0.6, 0.0, 0.8]);
+        assert!((v[2] - MAX_CLIMB).abs() < 1e-12);
+        assert!(((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt() - 1.0).abs() < 1e-12);
+        assert_eq!(clamp_climb([1.0, 0.0, 0.0]), [1.0, 0.0, 0.0]);
+    }
+}
