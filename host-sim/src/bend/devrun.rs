@@ -206,17 +206,17 @@ fn devrun() {
         );
         let (ox, oy) = (traj.samples[0].x, traj.samples[0].y);
         for t in &tracks {
-            let a = t.points[0] as usize;
-            let z = *t.points.last().unwrap() as usize;
+            let a = t.xyz[0];
+            let z = *t.xyz.last().unwrap();
             eprintln!(
                 "  track {:?} {} pts {:.1} m ({:.1},{:.1})->({:.1},{:.1}) covered {:.2}",
                 t.side,
                 t.points.len(),
                 postfilter::track_length_m(&input, t),
-                input.x[a] - ox,
-                input.y[a] - oy,
-                input.x[z] - ox,
-                input.y[z] - oy,
+                a[0] - ox,
+                a[1] - oy,
+                z[0] - ox,
+                z[1] - oy,
                 postfilter::covered_share(&input, &grid, t, p)
             );
         }

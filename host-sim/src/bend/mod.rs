@@ -32,6 +32,9 @@ pub struct Candidate {
 
 /// Status value meaning "kept, with a bend angle" (mirrors `curbtrace_core::kernel::PointStatus::Kept`).
 pub const STATUS_KEPT: u8 = 0;
+/// Status value for "kept, but no neighbour within d_b on one side, so no ρ" (mirrors
+/// `curbtrace_core::kernel::PointStatus::NoNeighbour`).
+pub const STATUS_NO_NEIGHBOUR: u8 = 2;
 /// Status value for points that never reached the kernel (outside the trajectory, dropped).
 pub const STATUS_NOT_PROCESSED: u8 = 255;
 

@@ -73,6 +73,30 @@ pub struct BendParams {
     /// total quality from 95.8 % to 97.8 % (right curb cuts 53 % → 100 %), while 10 steps
     /// gave the same.
     pub max_gap_steps: u32,
+    /// Whether a step whose search set S holds no point with ρ at or above `stop_rho_deg`
+    /// looks for the toe on a virtual profile across the search direction, built from the
+    /// points of several scanlines (`track::profile_toe`), before it counts as a gap. Not in
+    /// the paper: its ρ is taken along each scanline, so it flattens where a curb turns to
+    /// run along the scanlines (intersection corners and side streets), while the height
+    /// step is still there between the scanlines.
+    pub profile_fallback: bool,
+    /// Half-width of the virtual profile across the search direction, metres: the toe may
+    /// lie up to this less 0.15 m from the search position. Not in the paper; 0.45 m leaves
+    /// 0.3 m either side, enough for a 5 m corner radius to bend away from a straight
+    /// prediction over a few steps.
+    pub profile_half_width_m: f64,
+    /// Half-length of the virtual profile along the search direction, metres. Not in the
+    /// paper; 0.15 m takes in two or three scanlines at 30–40 km/h where a side street's
+    /// curb lies between them.
+    pub profile_half_length_m: f64,
+    /// Smallest height step a virtual profile takes as a curb, metres. Not in the paper;
+    /// the same 50 mm that separates curbs from curb cuts (`curb_cut_max_step_m`): only
+    /// full curbs are followed between scanlines, never a slight ramp or rut.
+    pub profile_min_step_m: f64,
+    /// Steepest slope across the profile of the road part and of the curb part of a
+    /// virtual profile, so that a ramp (behind a curb cut) is not taken for a step. Not in
+    /// the paper; 10 % is above road cross slopes and sidewalk falls.
+    pub profile_max_slope: f64,
     /// Upper bound of steps per track (per direction): a safety net only.
     pub max_steps: u32,
     /// Distance, metres, within which a track is taken to have reached another track (it
@@ -151,6 +175,11 @@ impl Default for BendParams {
             stop_rho_deg: 10.0,
             min_sigma_rho_deg: 1.0,
             max_gap_steps: 6,
+            profile_fallback: true,
+            profile_half_width_m: 0.45,
+            profile_half_length_m: 0.15,
+            profile_min_step_m: 0.05,
+            profile_max_slope: 0.1,
             max_steps: 200_000,
             join_distance_m: 0.05,
             min_edge_length_m: 1.0,

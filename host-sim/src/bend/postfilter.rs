@@ -24,13 +24,10 @@ fn pos(input: &BendInput, p: u32) -> [f64; 3] {
 }
 
 /// Horizontal length of a track, metres.
-pub fn track_length_m(input: &BendInput, t: &Track) -> f64 {
-    t.points
+pub fn track_length_m(_input: &BendInput, t: &Track) -> f64 {
+    t.xyz
         .windows(2)
-        .map(|w| {
-            let (a, b) = (pos(input, w[0]), pos(input, w[1]));
-            (b[0] - a[0]).hypot(b[1] - a[1])
-        })
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
         .sum()
 }
 
@@ -45,12 +42,11 @@ pub fn remove_short(input: &BendInput, tracks: Vec<Track>, params: &BendParams) 
 /// Share of a track's points that have at least two points of the cloud in the height
 /// band `[vehicle_band_low_m, vehicle_band_high_m]` above them within `vehicle_radius_m`.
 pub fn covered_share(input: &BendInput, grid: &PointGrid, t: &Track, params: &BendParams) -> f64 {
-    if t.points.is_empty() {
+    if t.xyz.is_empty() {
         return 0.0;
     }
     let mut covered = 0usize;
-    for &p in &t.points {
-        let q = pos(input, p);
+    for &q in &t.xyz {
         let mut n = 0;
         grid.for_each_within(input.x, input.y, q[0], q[1], params.vehicle_radius_m, |i| {
             let dz = input.z[i] - q[2];
@@ -62,7 +58,7 @@ pub fn covered_share(input: &BendInput, grid: &PointGrid, t: &Track, params: &Be
             covered += 1;
         }
     }
-    covered as f64 / t.points.len() as f64
+    covered as f64 / t.xyz.len() as f64
 }
 
 /// Filter 2: removes tracks under vehicles (see [`covered_share`]).
@@ -99,19 +95,11 @@ fn segments_cross(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
 /// centimetres where a track stopped and the next one started (at a curb cut, say) would
 /// remove each other's neighbour. All tests are made against the tracks as they came in,
 /// so the result does not depend on their order.
-pub fn remove_outside_roadway(input: &BendInput, route: &Route, tracks: Vec<Track>) -> Vec<Track> {
+pub fn remove_outside_roadway(_input: &BendInput, route: &Route, tracks: Vec<Track>) -> Vec<Track> {
     const ROADWAY_SAMPLE_M: f64 = 1.0;
     let polys: Vec<Vec<[f64; 2]>> = tracks
         .iter()
-        .map(|t| {
-            t.points
-                .iter()
-                .map(|&p| {
-                    let q = pos(input, p);
-                    [q[0], q[1]]
-                })
-                .collect()
-        })
+        .map(|t| t.xyz.iter().map(|q| [q[0], q[1]]).collect())
         .collect();
     let bbox = |poly: &[[f64; 2]]| {
         poly.iter().fold(
@@ -228,11 +216,7 @@ pub fn height_steps(
     t: &Track,
     params: &BendParams,
 ) -> Vec<Option<f64>> {
-    let xy: Vec<[f64; 2]> = t
-        .points
-        .iter()
-        .map(|&p| [input.x[p as usize], input.y[p as usize]])
-        .collect();
+    let xy: Vec<[f64; 2]> = t.xyz.iter().map(|q| [q[0], q[1]]).collect();
     let (g, w) = (params.step_gap_m, params.step_strip_m);
     let along_max = 0.15;
     let step_at = |k: usize| -> Option<f64> {
@@ -293,14 +277,16 @@ pub fn to_edge_lines(
 ) -> Vec<EdgeLine> {
     let mut out = Vec::new();
     for t in tracks {
+        // Virtual vertices (ids past the points) have no scanline neighbours to refine on.
         let raw: Vec<[f64; 3]> = t
             .points
             .iter()
-            .map(|&p| {
-                if params.refine_peak {
+            .zip(&t.xyz)
+            .map(|(&p, &q)| {
+                if params.refine_peak && (p as usize) < input.x.len() {
                     refined_pos(input, p)
                 } else {
-                    pos(input, p)
+                    q
                 }
             })
             .collect();

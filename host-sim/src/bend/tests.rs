@@ -510,20 +510,15 @@ fn an_edge_behind_another_is_outside_the_roadway() {
         v.sort_by(|&a, &b| input.x[a as usize].total_cmp(&input.x[b as usize]));
         v
     };
-    let front = track::Track {
-        points: pick(4.98),
-        side: Side::Left,
-    };
-    let behind = track::Track {
-        points: pick(6.5),
-        side: Side::Left,
-    };
+    let front = track::Track::measured(&input, pick(4.98), Side::Left);
+    let behind = track::Track::measured(&input, pick(6.5), Side::Left);
     assert!(front.points.len() > 10 && behind.points.len() > 10);
     // The back one is shorter so its ends look at the trajectory across the front one.
-    let behind = track::Track {
-        points: behind.points[5..behind.points.len() - 5].to_vec(),
-        ..behind
-    };
+    let behind = track::Track::measured(
+        &input,
+        behind.points[5..behind.points.len() - 5].to_vec(),
+        Side::Left,
+    );
     let kept = postfilter::remove_outside_roadway(&input, &route, vec![front.clone(), behind]);
     assert_eq!(kept, vec![front]);
 }

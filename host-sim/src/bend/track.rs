@@ -13,16 +13,37 @@ use std::collections::HashMap;
 use super::grid::PointGrid;
 use super::params::BendParams;
 use super::seed::Seed;
-use super::{BendInput, STATUS_KEPT};
+use super::{BendInput, STATUS_KEPT, STATUS_NO_NEIGHBOUR};
 use crate::model::Side;
 
-/// One tracked edge: point indices in order along the driving direction.
+/// One tracked edge: its vertices in order along the driving direction.
+///
+/// A vertex is either a measured point (its id is the point's index into the columns) or
+/// a toe found on a virtual profile ([`profile_toe`]) between the points (its id is at
+/// least the number of points, unique within one run). `xyz` holds every vertex's
+/// position, so nothing downstream needs to tell the two apart.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Track {
-    /// Point indices (into the columns), ordered along the edge.
+    /// Vertex ids, ordered along the edge.
     pub points: Vec<u32>,
+    /// Vertex positions (world X, Y, Z, metres), one per id.
+    pub xyz: Vec<[f64; 3]>,
     /// Side of the trajectory.
     pub side: Side,
+}
+
+impl Track {
+    /// A track of measured points only.
+    pub fn measured(input: &BendInput, points: Vec<u32>, side: Side) -> Self {
+        let xyz = points
+            .iter()
+            .map(|&p| {
+                let i = p as usize;
+                [input.x[i], input.y[i], input.z[i]]
+            })
+            .collect();
+        Self { points, xyz, side }
+    }
 }
 
 /// Where a one-directional track ended on another track.
@@ -35,8 +56,9 @@ struct Join {
 /// Segments of accepted tracks, bucketed for the join test: a point is on a track when it
 /// lies within the join distance of one of its segments (vertices alone would miss a seed
 /// on a scanline the track stepped over).
-/// A track segment: its two end points and the track it belongs to.
-type Segment = (u32, u32, usize);
+/// A track segment: its two end vertices (id and horizontal position) and the track it
+/// belongs to.
+type Segment = ((u32, [f64; 2]), (u32, [f64; 2]), usize);
 
 struct Claims {
     join_m: f64,
@@ -60,27 +82,25 @@ impl Claims {
         )
     }
 
-    /// Registers a track's polyline (a single point is a segment of length zero).
-    fn add_track(&mut self, input: &BendInput, points: &[u32], track: usize) {
+    /// Registers a track's polyline (a single vertex is a segment of length zero).
+    fn add_track(&mut self, points: &[u32], xyz: &[[f64; 3]], track: usize) {
         for &p in points {
             self.owner.insert(p, track);
         }
-        let segs: Vec<(u32, u32)> = if points.len() == 1 {
-            vec![(points[0], points[0])]
+        let v: Vec<(u32, [f64; 2])> = points
+            .iter()
+            .zip(xyz)
+            .map(|(&p, q)| (p, [q[0], q[1]]))
+            .collect();
+        let segs: Vec<_> = if v.len() == 1 {
+            vec![(v[0], v[0])]
         } else {
-            points.windows(2).map(|w| (w[0], w[1])).collect()
+            v.windows(2).map(|w| (w[0], w[1])).collect()
         };
         for (a, b) in segs {
-            let (ia, ib) = (a as usize, b as usize);
             let r = self.join_m;
-            let (x0, y0) = (
-                input.x[ia].min(input.x[ib]) - r,
-                input.y[ia].min(input.y[ib]) - r,
-            );
-            let (x1, y1) = (
-                input.x[ia].max(input.x[ib]) + r,
-                input.y[ia].max(input.y[ib]) + r,
-            );
+            let (x0, y0) = (a.1[0].min(b.1[0]) - r, a.1[1].min(b.1[1]) - r);
+            let (x1, y1) = (a.1[0].max(b.1[0]) + r, a.1[1].max(b.1[1]) + r);
             let (c0, c1) = (self.cell(x0, y0), self.cell(x1, y1));
             // A segment longer than a few hundred cells is a broken input; skip the rest.
             let cells = (c1.0 - c0.0 + 1).saturating_mul(c1.1 - c0.1 + 1);
@@ -95,28 +115,26 @@ impl Claims {
         }
     }
 
-    /// The nearest segment of a track other than `own` within the join distance of point
-    /// `i` (ties: lower track, then earlier registration); the join point is the
-    /// segment's nearer end.
-    fn near(&self, input: &BendInput, i: usize, own: usize) -> Option<Join> {
-        if let Some(&t) = self.owner.get(&(i as u32)) {
+    /// The nearest segment of a track other than `own` within the join distance of vertex
+    /// `id` at `(px, py)` (ties: lower track, then earlier registration); the join point is
+    /// the segment's nearer end.
+    fn near(&self, id: u32, px: f64, py: f64, own: usize) -> Option<Join> {
+        if let Some(&t) = self.owner.get(&id) {
             if t != own {
                 return Some(Join {
                     track: t,
-                    point: i as u32,
+                    point: id,
                 });
             }
         }
-        let (px, py) = (input.x[i], input.y[i]);
         let v = self.cells.get(&self.cell(px, py))?;
         let mut best: Option<(f64, usize, u32)> = None;
         for &(a, b, t) in v {
             if t == own {
                 continue;
             }
-            let (ia, ib) = (a as usize, b as usize);
-            let (ax, ay) = (input.x[ia], input.y[ia]);
-            let (dx, dy) = (input.x[ib] - ax, input.y[ib] - ay);
+            let (ax, ay) = (a.1[0], a.1[1]);
+            let (dx, dy) = (b.1[0] - ax, b.1[1] - ay);
             let l2 = dx * dx + dy * dy;
             let u = if l2 > 0.0 {
                 (((px - ax) * dx + (py - ay) * dy) / l2).clamp(0.0, 1.0)
@@ -124,7 +142,7 @@ impl Claims {
                 0.0
             };
             let d = (ax + u * dx - px).hypot(ay + u * dy - py);
-            let end = if u < 0.5 { a } else { b };
+            let end = if u < 0.5 { a.0 } else { b.0 };
             if d <= self.join_m && best.is_none_or(|(bd, bt, _)| (d, t) < (bd, bt)) {
                 best = Some((d, t, end));
             }
@@ -150,6 +168,8 @@ pub fn track_edges(
         }
         t
     }
+    // Ids of virtual vertices count up from the number of points.
+    let mut next_virtual = input.x.len() as u32;
 
     for seed in seeds {
         let s = seed.point as usize;
@@ -157,33 +177,51 @@ pub fn track_edges(
             continue;
         }
         let id = tracks.len();
-        if claims.near(input, s, id).is_some() {
+        if claims
+            .near(seed.point, input.x[s], input.y[s], id)
+            .is_some()
+        {
             continue; // this stretch has been tracked already
         }
         let dir = [seed.dir[0], seed.dir[1], 0.0];
-        let (fwd, fwd_join) = track_one_way(input, grid, &claims, id, seed.point, dir, params);
-        let (bwd, bwd_join) = track_one_way(
-            input,
-            grid,
-            &claims,
-            id,
-            seed.point,
-            [-dir[0], -dir[1], 0.0],
-            params,
-        );
-        let mut points: Vec<u32> = bwd.iter().rev().copied().collect();
-        points.push(seed.point);
-        points.extend_from_slice(&fwd);
-        claims.add_track(input, &points, id);
+        // Which side of the forward direction the curb rises on: measured at the seed, or
+        // from the side of the trajectory when the seed sees no step.
+        let up_fwd = up_side(input, grid, s, seed.dir).unwrap_or(match seed.side {
+            Side::Left => 1.0,
+            Side::Right => -1.0,
+        });
+        let mut one_way = |d: [f64; 3], up: f64| {
+            track_one_way(
+                input,
+                grid,
+                &claims,
+                id,
+                seed.point,
+                d,
+                up,
+                &mut next_virtual,
+                params,
+            )
+        };
+        let (fwd, fwd_join) = one_way(dir, up_fwd);
+        let (bwd, bwd_join) = one_way([-dir[0], -dir[1], 0.0], -up_fwd);
+        let seed_xyz = [input.x[s], input.y[s], input.z[s]];
+        let mut verts: Vec<(u32, [f64; 3])> = bwd.iter().rev().copied().collect();
+        verts.push((seed.point, seed_xyz));
+        verts.extend_from_slice(&fwd);
+        let points: Vec<u32> = verts.iter().map(|v| v.0).collect();
+        let xyz: Vec<[f64; 3]> = verts.iter().map(|v| v.1).collect();
+        claims.add_track(&points, &xyz, id);
         tracks.push(Some(Track {
             points,
+            xyz,
             side: seed.side,
         }));
         parent.push(id);
 
         // Join end to end with the tracks this one ran into.
-        let fwd_end = fwd.last().copied().unwrap_or(seed.point);
-        let bwd_end = bwd.last().copied().unwrap_or(seed.point);
+        let fwd_end = fwd.last().map_or(seed.point, |v| v.0);
+        let bwd_end = bwd.last().map_or(seed.point, |v| v.0);
         for (join, end_point) in [(fwd_join, fwd_end), (bwd_join, bwd_end)] {
             let Some(j) = join else { continue };
             let me = root(&parent, id);
@@ -211,24 +249,35 @@ pub fn track_edges(
             if !(at_other_start || at_other_end) {
                 continue; // met in the middle: two edges meeting, keep both
             }
-            let mut a_pts = a.points.clone();
-            let mut b_pts = b.points.clone();
+            let mut a_v: Vec<(u32, [f64; 3])> = a
+                .points
+                .iter()
+                .copied()
+                .zip(a.xyz.iter().copied())
+                .collect();
+            let mut b_v: Vec<(u32, [f64; 3])> = b
+                .points
+                .iter()
+                .copied()
+                .zip(b.xyz.iter().copied())
+                .collect();
             // Orient so that the join is a's end and b's start.
             if !at_end {
-                a_pts.reverse();
+                a_v.reverse();
             }
             if !at_other_start {
-                b_pts.reverse();
+                b_v.reverse();
             }
-            a_pts.extend_from_slice(&b_pts);
+            a_v.extend_from_slice(&b_v);
             // Keep the driving-direction order of the longer piece.
             let keep_a_order = a.points.len() >= b.points.len();
             if (keep_a_order && !at_end) || (!keep_a_order && !at_other_start) {
-                a_pts.reverse();
+                a_v.reverse();
             }
             let side = a.side;
             tracks[me] = Some(Track {
-                points: a_pts,
+                points: a_v.iter().map(|v| v.0).collect(),
+                xyz: a_v.iter().map(|v| v.1).collect(),
                 side,
             });
             tracks[other] = None;
@@ -238,10 +287,249 @@ pub fn track_edges(
     tracks.into_iter().flatten().collect()
 }
 
+/// Whether the ground rises on the left (+1) or the right (−1) of the horizontal direction
+/// `dir` at point `i`: mean heights of the strips 0.1–0.4 m either side, ±0.3 m along.
+/// `None` when the two differ by less than 20 mm (no step to go by).
+fn up_side(input: &BendInput, grid: &PointGrid, i: usize, dir: [f64; 2]) -> Option<f64> {
+    let l = dir[0].hypot(dir[1]);
+    if !(l > 1e-9) {
+        return None;
+    }
+    let h = [dir[0] / l, dir[1] / l];
+    let n = [-h[1], h[0]];
+    let (px, py, pz) = (input.x[i], input.y[i], input.z[i]);
+    let (mut sl, mut nl, mut sr, mut nr) = (0.0, 0usize, 0.0, 0usize);
+    grid.for_each_within(input.x, input.y, px, py, 0.5, |j| {
+        if !usable(input, j) || (input.z[j] - pz).abs() > 0.4 {
+            return;
+        }
+        let d = [input.x[j] - px, input.y[j] - py];
+        let along = d[0] * h[0] + d[1] * h[1];
+        let across = d[0] * n[0] + d[1] * n[1];
+        if along.abs() > 0.3 {
+            return;
+        }
+        if (0.1..=0.4).contains(&across) {
+            sl += input.z[j];
+            nl += 1;
+        } else if (-0.4..=-0.1).contains(&across) {
+            sr += input.z[j];
+            nr += 1;
+        }
+    });
+    if nl < 3 || nr < 3 {
+        return None;
+    }
+    let diff = sl / nl as f64 - sr / nr as f64;
+    (diff.abs() >= 0.02).then_some(diff.signum())
+}
+
+/// Points a virtual profile may use: kept by the core, with or without a bend angle.
+fn usable(input: &BendInput, i: usize) -> bool {
+    input.status[i] == STATUS_KEPT || input.status[i] == STATUS_NO_NEIGHBOUR
+}
+
+/// A curb toe found on a virtual profile.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProfileToe {
+    /// Toe position: horizontal on the profile line, height of the road beside it.
+    pub xyz: [f64; 3],
+    /// Height step from the road to the curb top, metres.
+    pub step_m: f64,
+}
+
+/// Finds the curb toe on a *virtual profile*: the points (of any scanline) within
+/// `profile_half_length_m` of the line through `centre` across the horizontal unit
+/// direction `along`, taken as one cross-section with `across` running from the road
+/// (negative) to the curb side (positive, `up` = +1 for the left of `along`, −1 for the
+/// right).
+///
+/// The per-scanline bend angle (Honma et al. §2.3) sees a curb only where the scanline
+/// crosses it; where a curb turns to run along the scanlines (the side streets of
+/// intersections, the far part of corner arcs) every scanline runs beside the toe and ρ
+/// stays flat, while the height step is still there *between* scanlines. The profile
+/// gathers it from several scanlines: the points sorted by `across` are split in two at
+/// the place that minimises the squared deviation from two levels (a least-squares step
+/// fit), and the toe is half-way between the last point of the low part and the first of
+/// the high part. Each part, without the 40 mm next to the toe (the face), is then fitted
+/// by a line, and the toe is accepted only as a curb: a step of at least
+/// `profile_min_step_m` (and under the search half-height) between the two lines at the
+/// toe, both parts ground-like (slopes under `profile_max_slope`, so a curb cut's ramp is
+/// no step), the lines' RMS under a quarter of the step, ground within 0.15 m on both
+/// sides of the toe, and the toe within `profile_half_width_m` − 0.15 m of the centre.
+pub fn profile_toe(
+    input: &BendInput,
+    grid: &PointGrid,
+    centre: [f64; 3],
+    along: [f64; 2],
+    up: f64,
+    params: &BendParams,
+) -> Option<ProfileToe> {
+    let half_w = params.profile_half_width_m;
+    let half_l = params.profile_half_length_m;
+    let n = [-along[1] * up, along[0] * up];
+    let mut prof: Vec<(f64, f64)> = Vec::new();
+    grid.for_each_within(
+        input.x,
+        input.y,
+        centre[0],
+        centre[1],
+        half_w.hypot(half_l),
+        |i| {
+            if !usable(input, i) || (input.z[i] - centre[2]).abs() > params.search_half_height_m {
+                return;
+            }
+            let d = [input.x[i] - centre[0], input.y[i] - centre[1]];
+            let a = d[0] * along[0] + d[1] * along[1];
+            let c = d[0] * n[0] + d[1] * n[1];
+            if a.abs() <= half_l && c.abs() <= half_w {
+                prof.push((c, input.z[i]));
+            }
+        },
+    );
+    const MIN_SIDE: usize = 4;
+    if prof.len() < 2 * MIN_SIDE {
+        if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
+            eprintln!(
+                "PROF {:.2} {:.2} m={} few",
+                centre[0],
+                centre[1],
+                prof.len()
+            );
+        }
+        return None;
+    }
+    prof.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
+    // Prefix sums of 1, c, c², z, c·z, z² (heights relative to the first point, for
+    // precision): a least-squares line over any run of the sorted points in O(1).
+    let z0 = prof[0].1;
+    let m = prof.len();
+    let mut acc = vec![[0.0f64; 6]; m + 1];
+    for (k, p) in prof.iter().enumerate() {
+        let (c, z) = (p.0, p.1 - z0);
+        let t = [1.0, c, c * c, z, c * z, z * z];
+        for j in 0..6 {
+            acc[k + 1][j] = acc[k][j] + t[j];
+        }
+    }
+    // Line z = a + b·c over prof[lo..hi]: (a, b, sse). Slope 0 when the run has a single
+    // position (one scanline beside a side street's curb).
+    let line = |lo: usize, hi: usize| -> (f64, f64, f64) {
+        let s: Vec<f64> = (0..6).map(|j| acc[hi][j] - acc[lo][j]).collect();
+        let (n, sc, scc, sz, scz, szz) = (s[0], s[1], s[2], s[3], s[4], s[5]);
+        let den = n * scc - sc * sc;
+        let b = if den > 1e-9 * n * n {
+            (n * scz - sc * sz) / den
+        } else {
+            0.0
+        };
+        let a = (sz - b * sc) / n;
+        // Σ(z − a − b·c)² expanded.
+        let sse = szz - 2.0 * a * sz - 2.0 * b * scz + n * a * a + 2.0 * a * b * sc + b * b * scc;
+        (a, b, sse.max(0.0))
+    };
+    // Σ(z − mean)² over prof[lo..hi].
+    let level_sse = |lo: usize, hi: usize| {
+        let (n, sz, szz) = (
+            (hi - lo) as f64,
+            acc[hi][3] - acc[lo][3],
+            acc[hi][5] - acc[lo][5],
+        );
+        (szz - sz * sz / n).max(0.0)
+    };
+    // Best split k: prof[..k] road, prof[k..] curb, each part one level. Points on the curb
+    // face go to the nearer level, so the split falls at the face's middle.
+    let mut best: Option<(f64, usize)> = None;
+    for k in MIN_SIDE..=m - MIN_SIDE {
+        if prof[k].0 - prof[k - 1].0 <= 0.0 {
+            continue; // a split must fall between two distinct positions
+        }
+        let e = level_sse(0, k) + level_sse(k, m);
+        if best.is_none_or(|(be, _)| e < be) {
+            best = Some((e, k));
+        }
+    }
+    let (_, k) = best?;
+    let toe = 0.5 * (prof[k - 1].0 + prof[k].0);
+    const NEAR_M: f64 = 0.15;
+    if prof[k].0 - prof[k - 1].0 > 2.0 * NEAR_M || toe.abs() > half_w - NEAR_M {
+        return None;
+    }
+    // The two parts without the face (FACE_M either side of the toe), each fitted by a
+    // line (road cross slope, sidewalk fall).
+    const FACE_M: f64 = 0.04;
+    let lo = prof.partition_point(|p| p.0 < toe - FACE_M);
+    let hi = prof.partition_point(|p| p.0 <= toe + FACE_M);
+    if lo < MIN_SIDE || m - hi < MIN_SIDE {
+        return None;
+    }
+    if prof[lo - 1].0 < toe - NEAR_M || prof[hi].0 > toe + NEAR_M {
+        return None; // no ground seen right beside the toe
+    }
+    let (la, lb, le) = line(0, lo);
+    let (ha, hb, he) = line(hi, m);
+    let step = (ha + hb * toe) - (la + lb * toe);
+    let rms = ((le + he) / (lo + m - hi) as f64).sqrt();
+    if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
+        eprintln!(
+            "PROF {:.2} {:.2} m={} k={} toe={:.3} gap={:.3} lb={:.3} hb={:.3} step={:.3} rms={:.4}",
+            centre[0],
+            centre[1],
+            m,
+            k,
+            toe,
+            prof[k].0 - prof[k - 1].0,
+            lb,
+            hb,
+            step,
+            rms
+        );
+    }
+    // Both parts must be ground, not a ramp or a car's flank.
+    let max_slope = params.profile_max_slope;
+    if lb.abs() > max_slope || hb.abs() > max_slope {
+        return None;
+    }
+    if step < params.profile_min_step_m || step > params.search_half_height_m {
+        return None;
+    }
+    if rms > 0.25 * step {
+        return None;
+    }
+    // The road height at the toe: the low points within NEAR_M of it.
+    let near_low: Vec<f64> = prof[..k]
+        .iter()
+        .filter(|p| toe - p.0 <= NEAR_M)
+        .map(|p| p.1)
+        .collect();
+    let z = near_low.iter().sum::<f64>() / near_low.len().max(1) as f64;
+    Some(ProfileToe {
+        xyz: [centre[0] + toe * n[0], centre[1] + toe * n[1], z],
+        step_m: step,
+    })
+}
+
 /// Weight of the newest step in the running turn per step (an exponential moving average
 /// over about five steps: long enough to average the toe points' scatter out, short enough
 /// to follow a 4 m corner radius).
 const TURN_EMA: f64 = 0.2;
+
+/// Largest vertical component of the search direction (a grade of about 15 %).
+const MAX_CLIMB: f64 = 0.15;
+
+/// `v` (a unit vector) with its vertical component clamped to ±[`MAX_CLIMB`], keeping its
+/// horizontal direction.
+fn clamp_climb(v: [f64; 3]) -> [f64; 3] {
+    if v[2].abs() <= MAX_CLIMB {
+        return v;
+    }
+    let h = v[0].hypot(v[1]);
+    if h < 1e-9 {
+        return v;
+    }
+    let k = (1.0 - MAX_CLIMB * MAX_CLIMB).sqrt() / h;
+    [v[0] * k, v[1] * k, MAX_CLIMB.copysign(v[2])]
+}
 
 fn unit3(v: [f64; 3]) -> Option<[f64; 3]> {
     let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -249,7 +537,11 @@ fn unit3(v: [f64; 3]) -> Option<[f64; 3]> {
 }
 
 /// Tracks from `start` along `dir0` until the stop rule of §2.7 fires or another track is
-/// reached. Returns the points picked (not including `start`) and the join, if any.
+/// reached. Where S holds no point with ρ of at least the stop threshold, the toe is looked
+/// for on a virtual profile across the search direction ([`profile_toe`]; the curb rises
+/// on the side `up` of the direction: +1 left, −1 right) before the step counts as a gap.
+/// Returns the vertices picked (not including `start`) and the join, if any.
+#[allow(clippy::too_many_arguments)]
 fn track_one_way(
     input: &BendInput,
     grid: &PointGrid,
@@ -257,15 +549,17 @@ fn track_one_way(
     own: usize,
     start: u32,
     dir0: [f64; 3],
+    up: f64,
+    next_virtual: &mut u32,
     params: &BendParams,
-) -> (Vec<u32>, Option<Join>) {
+) -> (Vec<(u32, [f64; 3])>, Option<Join>) {
     let s = start as usize;
     let mut cur = [input.x[s], input.y[s], input.z[s]];
     let Some(mut v) = unit3(dir0) else {
         return (Vec::new(), None);
     };
     let mut prev_u = v;
-    let mut picked: Vec<u32> = Vec::new();
+    let mut picked: Vec<(u32, [f64; 3])> = Vec::new();
     let mut own_pts: std::collections::HashSet<u32> = std::collections::HashSet::new();
     own_pts.insert(start);
     let mut gap = 0u32;
@@ -311,56 +605,91 @@ fn track_one_way(
             .iter()
             .map(|&i| input.rho_deg[i] as f64)
             .fold(f64::NEG_INFINITY, f64::max);
-        if set.is_empty() || max_rho < stop_rho {
-            // §2.7 stop rule; optionally bridge a few empty or weak steps.
-            if gap < params.max_gap_steps {
-                gap += 1;
-                cur = pred;
-                let (c, sn) = (turn.cos(), turn.sin());
-                v = [c * v[0] - sn * v[1], sn * v[0] + c * v[1], v[2]];
-                continue;
+        let next: (u32, [f64; 3]) = if set.is_empty() || max_rho < stop_rho {
+            // §2.7 stop rule, unless a virtual profile across the search direction shows
+            // the toe; optionally bridge a few empty or weak steps.
+            let along = [vh[0] / vh_len, vh[1] / vh_len];
+            let found = if params.profile_fallback && *next_virtual < u32::MAX {
+                // Heights are gated around the last vertex's, not the prediction's: a few
+                // steps climbing a curb face tilt v upwards, and the profile must still
+                // see the road.
+                profile_toe(input, grid, [pred[0], pred[1], cur[2]], along, up, params)
+            } else {
+                None
+            };
+            match found {
+                Some(toe) => {
+                    let id = *next_virtual;
+                    *next_virtual += 1;
+                    (id, toe.xyz)
+                }
+                None if gap < params.max_gap_steps => {
+                    gap += 1;
+                    cur = pred;
+                    let (c, sn) = (turn.cos(), turn.sin());
+                    v = [c * v[0] - sn * v[1], sn * v[0] + c * v[1], v[2]];
+                    continue;
+                }
+                None => {
+                    if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
+                        eprintln!("STOP {} {:.3} {:.3}", own, cur[0], cur[1]);
+                    }
+                    break;
+                }
             }
-            break;
-        }
-        // μ_ρ, σ_ρ over S (Eq. 5).
-        let k = set.len() as f64;
-        let mu = set.iter().map(|&i| input.rho_deg[i] as f64).sum::<f64>() / k;
-        let var = set
-            .iter()
-            .map(|&i| (input.rho_deg[i] as f64 - mu).powi(2))
-            .sum::<f64>()
-            / k;
-        let sigma = var.sqrt().max(params.min_sigma_rho_deg);
-        let v_elev = v[2].atan2(vh_len);
-        let mut best: Option<(f64, usize)> = None;
-        for &i in &set {
-            let d = [
-                input.x[i] - cur[0],
-                input.y[i] - cur[1],
-                input.z[i] - cur[2],
-            ];
-            let dh = d[0].hypot(d[1]);
-            let e_b = -(input.rho_deg[i] as f64 - mu) / sigma;
-            // Horizontal angle between v and d (Eq. 6), in [0, π].
-            let cross = vh[0] * d[1] - vh[1] * d[0];
-            let dot = vh[0] * d[0] + vh[1] * d[1];
-            let th_h = cross.atan2(dot).abs();
-            // Vertical angle between v and d (Eq. 7), in [0, π/2] after clamping.
-            let th_v = (d[2].atan2(dh) - v_elev)
-                .abs()
-                .min(std::f64::consts::FRAC_PI_2);
-            let e = params.alpha * e_b
-                + params.beta * th_h / std::f64::consts::PI
-                + params.gamma * 2.0 * th_v / std::f64::consts::PI;
-            if best.is_none_or(|(be, bi)| e < be || (e == be && i < bi)) {
-                best = Some((e, i));
+        } else {
+            // μ_ρ, σ_ρ over S (Eq. 5).
+            let k = set.len() as f64;
+            let mu = set.iter().map(|&i| input.rho_deg[i] as f64).sum::<f64>() / k;
+            let var = set
+                .iter()
+                .map(|&i| (input.rho_deg[i] as f64 - mu).powi(2))
+                .sum::<f64>()
+                / k;
+            let sigma = var.sqrt().max(params.min_sigma_rho_deg);
+            let v_elev = v[2].atan2(vh_len);
+            let mut best: Option<(f64, usize)> = None;
+            for &i in &set {
+                let d = [
+                    input.x[i] - cur[0],
+                    input.y[i] - cur[1],
+                    input.z[i] - cur[2],
+                ];
+                let dh = d[0].hypot(d[1]);
+                let e_b = -(input.rho_deg[i] as f64 - mu) / sigma;
+                // Horizontal angle between v and d (Eq. 6), in [0, π].
+                let cross = vh[0] * d[1] - vh[1] * d[0];
+                let dot = vh[0] * d[0] + vh[1] * d[1];
+                let th_h = cross.atan2(dot).abs();
+                // Vertical angle between v and d (Eq. 7), in [0, π/2] after clamping.
+                let th_v = (d[2].atan2(dh) - v_elev)
+                    .abs()
+                    .min(std::f64::consts::FRAC_PI_2);
+                let e = params.alpha * e_b
+                    + params.beta * th_h / std::f64::consts::PI
+                    + params.gamma * 2.0 * th_v / std::f64::consts::PI;
+                if best.is_none_or(|(be, bi)| e < be || (e == be && i < bi)) {
+                    best = Some((e, i));
+                }
             }
+            let Some((_, n)) = best else { break };
+            (n as u32, [input.x[n], input.y[n], input.z[n]])
+        };
+        let (n, p) = next;
+        if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
+            eprintln!(
+                "STEP {} {:.3} {:.3} {:.3} virt={} gap={}",
+                own,
+                p[0],
+                p[1],
+                p[2],
+                n as usize >= input.x.len(),
+                gap
+            );
         }
-        let Some((_, n)) = best else { break };
-        if let Some(j) = claims.near(input, n, own) {
+        if let Some(j) = claims.near(n, p[0], p[1], own) {
             return (picked, Some(j));
         }
-        let p = [input.x[n], input.y[n], input.z[n]];
         let Some(u) = unit3([p[0] - cur[0], p[1] - cur[1], p[2] - cur[2]]) else {
             break;
         };
@@ -371,6 +700,10 @@ fn track_one_way(
             params.a * u[2] + params.b * prev_u[2],
         ])
         .unwrap_or(u);
+        // Roads climb at most a few per cent: a steeper v comes from points picked on a
+        // curb face, and would lift the search position off the ground within a few gap
+        // steps.
+        let v_new = clamp_climb(v_new);
         if gap == 0 {
             let dturn =
                 (v[0] * v_new[1] - v[1] * v_new[0]).atan2(v[0] * v_new[0] + v[1] * v_new[1]);
@@ -378,10 +711,192 @@ fn track_one_way(
         }
         v = v_new;
         prev_u = u;
-        picked.push(n as u32);
-        own_pts.insert(n as u32);
+        picked.push((n, p));
+        own_pts.insert(n);
         cur = p;
         gap = 0;
     }
     (picked, None)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::trajectory::Trajectory;
+
+    /// A street corner seen by scanlines across x (one every 0.11 m, points every 2 cm
+    /// along y): the main curb along y = 5 up to x = 7, a quarter circle of radius 3 about
+    /// (7, 8), then the side street's curb along x = 10 from y = 8 to y = 14. The sidewalk
+    /// is 0.15 m up. ρ = 60° · |t_x| at the last road point before each rise along a
+    /// scanline (t: the curb's unit tangent), so it fades as the corner turns to run along
+    /// the scanlines, and is 0 on the side street, which no scanline crosses.
+    struct Corner {
+        x: Vec<f64>,
+        y: Vec<f64>,
+        z: Vec<f64>,
+        t: Vec<f64>,
+        rho: Vec<f32>,
+        status: Vec<u8>,
+        scanline: Vec<u32>,
+        traj: Trajectory,
+    }
+
+    fn sidewalk(x: f64, y: f64) -> bool {
+        let fillet = x > 7.0 && y < 8.0 && (x - 7.0).powi(2) + (y - 8.0).powi(2) > 9.0;
+        y > 5.0 && x < 10.0 && !fillet
+    }
+
+    /// Distance from (x, y) to the toe line.
+    fn toe_dist(x: f64, y: f64) -> f64 {
+        if x <= 7.0 {
+            (y - 5.0).abs()
+        } else if y >= 8.0 {
+            (x - 10.0).abs()
+        } else {
+            ((x - 7.0).hypot(y - 8.0) - 3.0).abs()
+        }
+    }
+
+    fn corner() -> Corner {
+        let mut c = Corner {
+            x: Vec::new(),
+            y: Vec::new(),
+            z: Vec::new(),
+            t: Vec::new(),
+            rho: Vec::new(),
+            status: Vec::new(),
+            scanline: Vec::new(),
+            traj: Trajectory::default(),
+        };
+        let mut line = 0u32;
+        let mut x = 0.013;
+        while x < 16.0 {
+            let mut y = 0.0;
+            while y < 16.0 {
+                let up = sidewalk(x, y);
+                let next_up = sidewalk(x, y + 0.02);
+                let rho = if !up && next_up {
+                    // The curb's tangent where this scanline meets it.
+                    let tx = if x <= 7.0 {
+                        1.0
+                    } else {
+                        (y + 0.02 - 8.0).abs() / 3.0
+                    };
+                    60.0 * tx
+                } else {
+                    0.0
+                };
+                c.x.push(x);
+                c.y.push(y);
+                c.z.push(if up { 0.15 } else { 0.0 });
+                c.t.push(line as f64 * 0.01 + y * 1e-5);
+                c.rho.push(rho as f32);
+                c.status.push(STATUS_KEPT);
+                c.scanline.push(line);
+                y += 0.02;
+            }
+            x += 0.11;
+            line += 1;
+        }
+        c
+    }
+
+    fn input(c: &Corner) -> BendInput<'_> {
+        BendInput {
+            x: &c.x,
+            y: &c.y,
+            z: &c.z,
+            t: &c.t,
+            rho_deg: &c.rho,
+            status: &c.status,
+            scanline: &c.scanline,
+            candidates: &[],
+            trajectory: &c.traj,
+        }
+    }
+
+    /// The track from a seed on the main curb at x ≈ 3.
+    fn track(c: &Corner, params: &BendParams) -> Track {
+        let inp = input(c);
+        let grid = PointGrid::build(inp.x, inp.y, 0.1, |_| true);
+        let seed = (0..c.x.len())
+            .filter(|&i| c.rho[i] > 30.0)
+            .min_by(|&a, &b| (c.x[a] - 3.0).abs().total_cmp(&(c.x[b] - 3.0).abs()))
+            .unwrap();
+        let seeds = [Seed {
+            point: seed as u32,
+            side: Side::Left,
+            dir: [1.0, 0.0],
+            interval: 0,
+            inlier_ratio: 1.0,
+        }];
+        let mut tracks = track_edges(&inp, &grid, &seeds, params);
+        assert_eq!(tracks.len(), 1);
+        tracks.remove(0)
+    }
+
+    #[test]
+    fn the_track_follows_a_corner_into_the_side_street() {
+        let c = corner();
+        let params = BendParams::default();
+        let t = track(&c, &params);
+        assert_eq!(t.points.len(), t.xyz.len());
+        // Every vertex on the toe: measured ones within the 2 cm point spacing, virtual
+        // ones within half the 0.11 m scanline spacing.
+        for q in &t.xyz {
+            assert!(toe_dist(q[0], q[1]) < 0.06, "vertex {q:?} off the toe");
+        }
+        // Along the side street to within a profile length of its end (y = 14).
+        let far = t.xyz.iter().map(|q| q[1]).fold(f64::MIN, f64::max);
+        assert!(far > 13.3, "stopped at y = {far}");
+        // The side street's vertices are virtual ones (ids past the points).
+        let n = c.x.len() as u32;
+        assert!(t
+            .points
+            .iter()
+            .zip(&t.xyz)
+            .filter(|(_, q)| q[1] > 9.0)
+            .all(|(&p, _)| p >= n));
+        // Without the virtual profile the track stops where ρ fades in the corner.
+        let off = BendParams {
+            profile_fallback: false,
+            ..BendParams::default()
+        };
+        let t0 = track(&c, &off);
+        let far0 = t0.xyz.iter().map(|q| q[1]).fold(f64::MIN, f64::max);
+        assert!(far0 < 9.0, "without profiles: y = {far0}");
+    }
+
+    #[test]
+    fn profile_finds_a_step_between_scanlines_and_rejects_a_ramp() {
+        let c = corner();
+        let inp = input(&c);
+        let grid = PointGrid::build(inp.x, inp.y, 0.1, |_| true);
+        let params = BendParams::default();
+        // Across the side street's curb (x = 10) at y = 11, walking north: the curb rises
+        // on the left (towards −x).
+        let toe =
+            profile_toe(&inp, &grid, [10.1, 11.0, 0.0], [0.0, 1.0], 1.0, &params).expect("a toe");
+        assert!((toe.xyz[0] - 10.0).abs() < 0.06, "{toe:?}");
+        assert!((toe.step_m - 0.15).abs() < 0.01, "{toe:?}");
+        // With the wrong side up there is no curb (the ground falls).
+        assert!(profile_toe(&inp, &grid, [10.1, 11.0, 0.0], [0.0, 1.0], -1.0, &params).is_none());
+        // A flat road gives nothing.
+        assert!(profile_toe(&inp, &grid, [13.0, 2.0, 0.0], [0.0, 1.0], 1.0, &params).is_none());
+        // A 20 % ramp (z = 0.2·x) is no step.
+        let ramp_z: Vec<f64> = c.x.iter().map(|&x| 0.2 * x).collect();
+        let ramp = BendInput {
+            z: &ramp_z,
+            ..input(&c)
+        };
+        assert!(profile_toe(&ramp, &grid, [13.0, 2.0, 2.6], [0.0, 1.0], 1.0, &params).is_none());
+    }
+
+    #[test]
+    fn climb_is_clamped_and_flat_directions_kept() {
+        let v = clamp_climb([0.6, 0.0, 0.8]);
+        assert!((v[2] - MAX_CLIMB).abs() < 1e-12);
+        assert!(((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt() - 1.0).abs() < 1e-12);
+        assert_eq!(clamp_climb([1.0, 0.0, 0.0]), [1.0, 0.0, 0.0]);
+    }
 }
