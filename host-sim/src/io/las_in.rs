@@ -371,6 +371,7 @@ fn check_laszip_vlr(
     file: &mut File,
     head_bytes: &[u8],
     head: &RawHead,
+    file_size: u64,
 ) -> Result<(), LasError> {
     use std::io::{Seek, SeekFrom};
     const VLR_HEADER_LEN: u64 = 54;
@@ -393,9 +394,14 @@ fn check_laszip_vlr(
     ]);
     let end = u64::from(head.offset_to_point_data);
     let mut pos = u64::from(head.header_size);
-    for _ in 0..vlrs {
+    for i in 0..vlrs {
         if pos + VLR_HEADER_LEN > end {
             break;
+        }
+        if pos + VLR_HEADER_LEN > file_size {
+            return Err(bad(format!(
+                "the file ends at byte {file_size}, inside variable-length record {i} of {vlrs}"
+            )));
         }
         let mut h = [0u8; VLR_HEADER_LEN as usize];
         file.seek(SeekFrom::Start(pos))
@@ -599,7 +605,7 @@ pub fn read_points(
         .map_err(io)?;
     let head = parse_raw_head(path, &head_bytes, file_size)?;
     check_evlrs(path, &mut file, &head_bytes, file_size)?;
-    check_laszip_vlr(path, &mut file, &head_bytes, &head)?;
+    check_laszip_vlr(path, &mut file, &head_bytes, &head, file_size)?;
     check_laz_chunk_table(path, &mut file, &head, file_size)?;
     if !format_has_gps_time(head.format) {
         return Err(LasError::NoGpsTime {
