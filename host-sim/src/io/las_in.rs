@@ -338,7 +338,7 @@ fn check_evlrs(path: &Path, file: &mut File, head: &[u8], file_size: u64) -> Res
             )));
         }
         let mut len = [0u8; 8];
-        file.seek(SeekFrom::Start(pos + 52))
+        file.seek(SeekFrom::Start(pos + 20))
             .and_then(|_| file.read_exact(&mut len))
             .map_err(|source| LasError::Io {
                 path: path.to_path_buf(),
@@ -1083,7 +1083,7 @@ pub(crate) mod tests {
         bytes[235..243].copy_from_slice(&end.to_le_bytes());
         bytes[243..247].copy_from_slice(&1u32.to_le_bytes());
         let mut evlr = vec![0u8; 60];
-        evlr[52..60].copy_from_slice(&(1u64 << 62).to_le_bytes());
+        evlr[20..28].copy_from_slice(&(1u64 << 62).to_le_bytes());
         bytes.extend_from_slice(&evlr);
         std::fs::write(&path, &bytes).unwrap();
         let err = read(&path, None).unwrap_err().to_string();
@@ -1092,8 +1092,29 @@ pub(crate) mod tests {
             "{err}"
         );
         // The same file with an honest EVLR length reads.
-        bytes[end as usize + 52..end as usize + 60].copy_from_slice(&0u64.to_le_bytes());
+        bytes[end as usize + 20..end as usize + 28].copy_from_slice(&0u64.to_le_bytes());
         std::fs::write(&path, &bytes).unwrap();
+        assert_eq!(read(&path, None).unwrap().0.t.len(), 10);
+        // An EVLR as the `las` crate writes it, with a description (the length field is at
+        // byte 20 of the EVLR header, the description after it), reads.
+        let mut b = Builder::from((1, 4));
+        b.point_format = las::point::Format::new(6).unwrap();
+        b.transforms.x.offset = 500_000.0;
+        b.transforms.y.offset = 4_000_000.0;
+        b.evlrs.push(las::Vlr {
+            user_id: "curbtrace".into(),
+            record_id: 7,
+            description: "a description of thirty-one chars"
+                .chars()
+                .take(31)
+                .collect(),
+            data: vec![0xff; 300],
+        });
+        let mut w = Writer::from_path(&path, b.into_header().unwrap()).unwrap();
+        for p in &pts {
+            w.write_point(p.clone()).unwrap();
+        }
+        w.close().unwrap();
         assert_eq!(read(&path, None).unwrap().0.t.len(), 10);
     }
 
