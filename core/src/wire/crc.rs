@@ -14,7 +14,7 @@
 //!
 //! Three software forms, bit-identical (tested): byte-at-a-time with one 256-entry table
 //! (1 KiB), slicing-by-4 (the first 4 KiB of the tables; one 32-bit load and four
-//! lookups per 4 bytes — the form for the M4F: 3.5 instructions per byte there against
+//! lookups per 4 bytes — the form for the M4F: 3.4 instructions per byte there against
 //! 5.5 byte-at-a-time, `docs/benchmarks.md`) and slicing-by-8 (8 KiB of tables, several
 //! times faster on a host CPU, but on the M4F it runs out of registers and counts more
 //! instructions than slicing-by-4). [`Crc32`] uses slicing-by-8 on targets with 64-bit
@@ -125,7 +125,7 @@ impl Crc32 {
     #[inline]
     pub fn update(&mut self, data: &[u8]) {
         self.reg = if cfg!(target_pointer_width = "64") {
-            update_slice4(self.reg, data)
+            update_slice8(self.reg, data)
         } else {
             update_slice4(self.reg, data)
         };

@@ -651,11 +651,6 @@ mod tests {
             180.0,
             -180.0,
             180.004,
-            1073.741_8,
-            -1073.741_8,
-            1073.741_9,
-            2147.483_5,
-            -2147.483_7,
             3000.0,
             f32::MAX,
             f32::MIN,
@@ -663,6 +658,14 @@ mod tests {
             f32::NEG_INFINITY,
             f32::NAN,
         ];
+        // Around 2^30 µm (the fast path's edge) and 2^31 µm (the i32 edge), ± a few ulps.
+        for edge in [1_073_741_824.0f32 * 1e-6, 2_147_483_648.0 * 1e-6] {
+            for k in 0..8u32 {
+                let up = f32::from_bits(edge.to_bits() + k);
+                let down = f32::from_bits(edge.to_bits() - k);
+                vals.extend([up, down, -up, -down]);
+            }
+        }
         let mut r = 99u64;
         for _ in 0..200_000 {
             r = r
