@@ -339,7 +339,7 @@ pub struct ProfileToe {
 }
 
 /// Finds the curb toe on a *virtual profile*: the points (of any scanline) within
-/// `profile_half_length_m` of the line through `centre` across the horizontal unit
+/// `half_l` of the line through `centre` across the horizontal unit
 /// direction `along`, taken as one cross-section with `across` running from the road
 /// (negative) to the curb side (positive, `up` = +1 for the left of `along`, −1 for the
 /// right).
@@ -363,10 +363,10 @@ pub fn profile_toe(
     centre: [f64; 3],
     along: [f64; 2],
     up: f64,
+    half_l: f64,
     params: &BendParams,
 ) -> Option<ProfileToe> {
     let half_w = params.profile_half_width_m;
-    let half_l = params.profile_half_length_m;
     let n = [-along[1] * up, along[0] * up];
     let mut prof: Vec<(f64, f64)> = Vec::new();
     grid.for_each_within(
@@ -613,7 +613,12 @@ fn track_one_way(
                 // Heights are gated around the last vertex's, not the prediction's: a few
                 // steps climbing a curb face tilt v upwards, and the profile must still
                 // see the road.
-                profile_toe(input, grid, [pred[0], pred[1], cur[2]], along, up, params)
+                // Far from the scanner the points are sparse along the scanlines: a
+                // profile twice as long is tried where the short one shows no toe.
+                let c = [pred[0], pred[1], cur[2]];
+                let l = params.profile_half_length_m;
+                profile_toe(input, grid, c, along, up, l, params)
+                    .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params))
             } else {
                 None
             };
@@ -875,21 +880,56 @@ mod tests {
         let params = BendParams::default();
         // Across the side street's curb (x = 10) at y = 11, walking north: the curb rises
         // on the left (towards −x).
-        let toe =
-            profile_toe(&inp, &grid, [10.1, 11.0, 0.0], [0.0, 1.0], 1.0, &params).expect("a toe");
+        let toe = profile_toe(
+            &inp,
+            &grid,
+            [10.1, 11.0, 0.0],
+            [0.0, 1.0],
+            1.0,
+            0.15,
+            &params,
+        )
+        .expect("a toe");
         assert!((toe.xyz[0] - 10.0).abs() < 0.06, "{toe:?}");
         assert!((toe.step_m - 0.15).abs() < 0.01, "{toe:?}");
         // With the wrong side up there is no curb (the ground falls).
-        assert!(profile_toe(&inp, &grid, [10.1, 11.0, 0.0], [0.0, 1.0], -1.0, &params).is_none());
+        assert!(profile_toe(
+            &inp,
+            &grid,
+            [10.1, 11.0, 0.0],
+            [0.0, 1.0],
+            -1.0,
+            0.15,
+            &params
+        )
+        .is_none());
         // A flat road gives nothing.
-        assert!(profile_toe(&inp, &grid, [13.0, 2.0, 0.0], [0.0, 1.0], 1.0, &params).is_none());
+        assert!(profile_toe(
+            &inp,
+            &grid,
+            [13.0, 2.0, 0.0],
+            [0.0, 1.0],
+            1.0,
+            0.15,
+            &params
+        )
+        .is_none());
         // A 20 % ramp (z = 0.2·x) is no step.
         let ramp_z: Vec<f64> = c.x.iter().map(|&x| 0.2 * x).collect();
         let ramp = BendInput {
             z: &ramp_z,
             ..input(&c)
         };
-        assert!(profile_toe(&ramp, &grid, [13.0, 2.0, 2.6], [0.0, 1.0], 1.0, &params).is_none());
+        assert!(profile_toe(
+            &ramp,
+            &grid,
+            [13.0, 2.0, 2.6],
+            [0.0, 1.0],
+            1.0,
+            0.15,
+            &params
+        )
+        .is_none());
     }
 
     #[test]
