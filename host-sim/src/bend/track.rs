@@ -389,14 +389,6 @@ pub fn profile_toe(
     );
     const MIN_SIDE: usize = 4;
     if prof.len() < 2 * MIN_SIDE {
-        if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
-            eprintln!(
-                "PROF {:.2} {:.2} m={} few",
-                centre[0],
-                centre[1],
-                prof.len()
-            );
-        }
         return None;
     }
     prof.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
@@ -470,21 +462,6 @@ pub fn profile_toe(
     let (ha, hb, he) = line(hi, m);
     let step = (ha + hb * toe) - (la + lb * toe);
     let rms = ((le + he) / (lo + m - hi) as f64).sqrt();
-    if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
-        eprintln!(
-            "PROF {:.2} {:.2} m={} k={} toe={:.3} gap={:.3} lb={:.3} hb={:.3} step={:.3} rms={:.4}",
-            centre[0],
-            centre[1],
-            m,
-            k,
-            toe,
-            prof[k].0 - prof[k - 1].0,
-            lb,
-            hb,
-            step,
-            rms
-        );
-    }
     // Both parts must be ground, not a ramp or a car's flank.
     let max_slope = params.profile_max_slope;
     if lb.abs() > max_slope || hb.abs() > max_slope {
@@ -513,6 +490,10 @@ pub fn profile_toe(
 /// over about five steps: long enough to average the toe points' scatter out, short enough
 /// to follow a 4 m corner radius).
 const TURN_EMA: f64 = 0.2;
+
+/// Largest height difference between consecutive toes picked by ρ before the virtual
+/// profile is asked instead, metres: 0.15 m apart on a 10 % grade they differ by 15 mm.
+const MAX_TOE_DZ_M: f64 = 0.04;
 
 /// Largest vertical component of the search direction (a grade of about 15 %).
 const MAX_CLIMB: f64 = 0.15;
@@ -636,9 +617,6 @@ fn track_one_way(
                     continue;
                 }
                 None => {
-                    if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
-                        eprintln!("STOP {} {:.3} {:.3}", own, cur[0], cur[1]);
-                    }
                     break;
                 }
             }
@@ -678,20 +656,29 @@ fn track_one_way(
                 }
             }
             let Some((_, n)) = best else { break };
-            (n as u32, [input.x[n], input.y[n], input.z[n]])
+            // Consecutive toes lie at nearly one height; a pick well above or below the
+            // last vertex is on the curb face or top (far from the scanner, where ρ is
+            // noisy), so the virtual profile's toe is taken instead when there is one.
+            let jumped = (input.z[n] - cur[2]).abs() > MAX_TOE_DZ_M;
+            let along = [vh[0] / vh_len, vh[1] / vh_len];
+            let c = [pred[0], pred[1], cur[2]];
+            let l = params.profile_half_length_m;
+            match (jumped && params.profile_fallback && *next_virtual < u32::MAX)
+                .then(|| {
+                    profile_toe(input, grid, c, along, up, l, params)
+                        .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params))
+                })
+                .flatten()
+            {
+                Some(toe) => {
+                    let id = *next_virtual;
+                    *next_virtual += 1;
+                    (id, toe.xyz)
+                }
+                None => (n as u32, [input.x[n], input.y[n], input.z[n]]),
+            }
         };
         let (n, p) = next;
-        if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
-            eprintln!(
-                "STEP {} {:.3} {:.3} {:.3} virt={} gap={}",
-                own,
-                p[0],
-                p[1],
-                p[2],
-                n as usize >= input.x.len(),
-                gap
-            );
-        }
         if let Some(j) = claims.near(n, p[0], p[1], own) {
             return (picked, Some(j));
         }
