@@ -292,7 +292,7 @@ pub fn track_edges(
 /// `None` when the two differ by less than 20 mm (no step to go by).
 fn up_side(input: &BendInput, grid: &PointGrid, i: usize, dir: [f64; 2]) -> Option<f64> {
     let l = dir[0].hypot(dir[1]);
-    if !(l > 1e-9) {
+    if l.is_nan() || l <= 1e-9 {
         return None;
     }
     let h = [dir[0] / l, dir[1] / l];
