@@ -368,7 +368,8 @@ pub fn profile_toe(
 ) -> Option<ProfileToe> {
     let half_w = params.profile_half_width_m;
     let n = [-along[1] * up, along[0] * up];
-    let mut prof: Vec<(f64, f64)> = Vec::new();
+    // (across, z, along) per point.
+    let mut prof: Vec<(f64, f64, f64)> = Vec::new();
     grid.for_each_within(
         input.x,
         input.y,
@@ -383,7 +384,7 @@ pub fn profile_toe(
             let a = d[0] * along[0] + d[1] * along[1];
             let c = d[0] * n[0] + d[1] * n[1];
             if a.abs() <= half_l && c.abs() <= half_w {
-                prof.push((c, input.z[i]));
+                prof.push((c, input.z[i], a));
             }
         },
     );
@@ -480,8 +481,20 @@ pub fn profile_toe(
         .map(|p| p.1)
         .collect();
     let z = near_low.iter().sum::<f64>() / near_low.len().max(1) as f64;
+    // Along the profile the toe sits among the points beside it, not at the centre: where
+    // the scanned area ends, the centre lies past the last scanline.
+    let near: Vec<f64> = prof
+        .iter()
+        .filter(|p| (p.0 - toe).abs() <= NEAR_M)
+        .map(|p| p.2)
+        .collect();
+    let a = near.iter().sum::<f64>() / near.len().max(1) as f64;
     Some(ProfileToe {
-        xyz: [centre[0] + toe * n[0], centre[1] + toe * n[1], z],
+        xyz: [
+            centre[0] + a * along[0] + toe * n[0],
+            centre[1] + a * along[1] + toe * n[1],
+            z,
+        ],
         step_m: step,
     })
 }
@@ -603,7 +616,11 @@ fn track_one_way(
             } else {
                 None
             };
-            match found {
+            // A virtual toe must lie ahead, as S's points must.
+            let ahead = |t: &ProfileToe| {
+                (t.xyz[0] - cur[0]) * along[0] + (t.xyz[1] - cur[1]) * along[1] > 0.25 * d_s
+            };
+            match found.filter(ahead) {
                 Some(toe) => {
                     let id = *next_virtual;
                     *next_virtual += 1;
@@ -669,7 +686,9 @@ fn track_one_way(
                         .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params))
                 })
                 .flatten()
-            {
+                .filter(|t| {
+                    (t.xyz[0] - cur[0]) * along[0] + (t.xyz[1] - cur[1]) * along[1] > 0.25 * d_s
+                }) {
                 Some(toe) => {
                     let id = *next_virtual;
                     *next_virtual += 1;
