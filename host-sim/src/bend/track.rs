@@ -292,7 +292,7 @@ pub fn track_edges(
 /// `None` when the two differ by less than 20 mm (no step to go by).
 fn up_side(input: &BendInput, grid: &PointGrid, i: usize, dir: [f64; 2]) -> Option<f64> {
     let l = dir[0].hypot(dir[1]);
-    if !(l > 1e-9) {
+    if l.is_nan() || l <= 1e-9 {
         return None;
     }
     let h = [dir[0] / l, dir[1] / l];
@@ -339,7 +339,7 @@ pub struct ProfileToe {
 }
 
 /// Finds the curb toe on a *virtual profile*: the points (of any scanline) within
-/// `profile_half_length_m` of the line through `centre` across the horizontal unit
+/// `half_l` of the line through `centre` across the horizontal unit
 /// direction `along`, taken as one cross-section with `across` running from the road
 /// (negative) to the curb side (positive, `up` = +1 for the left of `along`, −1 for the
 /// right).
@@ -363,12 +363,13 @@ pub fn profile_toe(
     centre: [f64; 3],
     along: [f64; 2],
     up: f64,
+    half_l: f64,
     params: &BendParams,
 ) -> Option<ProfileToe> {
     let half_w = params.profile_half_width_m;
-    let half_l = params.profile_half_length_m;
     let n = [-along[1] * up, along[0] * up];
-    let mut prof: Vec<(f64, f64)> = Vec::new();
+    // (across, z, along) per point.
+    let mut prof: Vec<(f64, f64, f64)> = Vec::new();
     grid.for_each_within(
         input.x,
         input.y,
@@ -383,20 +384,12 @@ pub fn profile_toe(
             let a = d[0] * along[0] + d[1] * along[1];
             let c = d[0] * n[0] + d[1] * n[1];
             if a.abs() <= half_l && c.abs() <= half_w {
-                prof.push((c, input.z[i]));
+                prof.push((c, input.z[i], a));
             }
         },
     );
     const MIN_SIDE: usize = 4;
     if prof.len() < 2 * MIN_SIDE {
-        if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
-            eprintln!(
-                "PROF {:.2} {:.2} m={} few",
-                centre[0],
-                centre[1],
-                prof.len()
-            );
-        }
         return None;
     }
     prof.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
@@ -470,21 +463,6 @@ pub fn profile_toe(
     let (ha, hb, he) = line(hi, m);
     let step = (ha + hb * toe) - (la + lb * toe);
     let rms = ((le + he) / (lo + m - hi) as f64).sqrt();
-    if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
-        eprintln!(
-            "PROF {:.2} {:.2} m={} k={} toe={:.3} gap={:.3} lb={:.3} hb={:.3} step={:.3} rms={:.4}",
-            centre[0],
-            centre[1],
-            m,
-            k,
-            toe,
-            prof[k].0 - prof[k - 1].0,
-            lb,
-            hb,
-            step,
-            rms
-        );
-    }
     // Both parts must be ground, not a ramp or a car's flank.
     let max_slope = params.profile_max_slope;
     if lb.abs() > max_slope || hb.abs() > max_slope {
@@ -503,8 +481,20 @@ pub fn profile_toe(
         .map(|p| p.1)
         .collect();
     let z = near_low.iter().sum::<f64>() / near_low.len().max(1) as f64;
+    // Along the profile the toe sits among the points beside it, not at the centre: where
+    // the scanned area ends, the centre lies past the last scanline.
+    let near: Vec<f64> = prof
+        .iter()
+        .filter(|p| (p.0 - toe).abs() <= NEAR_M)
+        .map(|p| p.2)
+        .collect();
+    let a = near.iter().sum::<f64>() / near.len().max(1) as f64;
     Some(ProfileToe {
-        xyz: [centre[0] + toe * n[0], centre[1] + toe * n[1], z],
+        xyz: [
+            centre[0] + a * along[0] + toe * n[0],
+            centre[1] + a * along[1] + toe * n[1],
+            z,
+        ],
         step_m: step,
     })
 }
@@ -513,6 +503,10 @@ pub fn profile_toe(
 /// over about five steps: long enough to average the toe points' scatter out, short enough
 /// to follow a 4 m corner radius).
 const TURN_EMA: f64 = 0.2;
+
+/// Largest height difference between consecutive toes picked by ρ before the virtual
+/// profile is asked instead, metres: 0.15 m apart on a 10 % grade they differ by 15 mm.
+const MAX_TOE_DZ_M: f64 = 0.04;
 
 /// Largest vertical component of the search direction (a grade of about 15 %).
 const MAX_CLIMB: f64 = 0.15;
@@ -613,11 +607,20 @@ fn track_one_way(
                 // Heights are gated around the last vertex's, not the prediction's: a few
                 // steps climbing a curb face tilt v upwards, and the profile must still
                 // see the road.
-                profile_toe(input, grid, [pred[0], pred[1], cur[2]], along, up, params)
+                // Far from the scanner the points are sparse along the scanlines: a
+                // profile twice as long is tried where the short one shows no toe.
+                let c = [pred[0], pred[1], cur[2]];
+                let l = params.profile_half_length_m;
+                profile_toe(input, grid, c, along, up, l, params)
+                    .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params))
             } else {
                 None
             };
-            match found {
+            // A virtual toe must lie ahead, as S's points must.
+            let ahead = |t: &ProfileToe| {
+                (t.xyz[0] - cur[0]) * along[0] + (t.xyz[1] - cur[1]) * along[1] > 0.25 * d_s
+            };
+            match found.filter(ahead) {
                 Some(toe) => {
                     let id = *next_virtual;
                     *next_virtual += 1;
@@ -631,9 +634,6 @@ fn track_one_way(
                     continue;
                 }
                 None => {
-                    if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
-                        eprintln!("STOP {} {:.3} {:.3}", own, cur[0], cur[1]);
-                    }
                     break;
                 }
             }
@@ -673,20 +673,31 @@ fn track_one_way(
                 }
             }
             let Some((_, n)) = best else { break };
-            (n as u32, [input.x[n], input.y[n], input.z[n]])
+            // Consecutive toes lie at nearly one height; a pick well above or below the
+            // last vertex is on the curb face or top (far from the scanner, where ρ is
+            // noisy), so the virtual profile's toe is taken instead when there is one.
+            let jumped = (input.z[n] - cur[2]).abs() > MAX_TOE_DZ_M;
+            let along = [vh[0] / vh_len, vh[1] / vh_len];
+            let c = [pred[0], pred[1], cur[2]];
+            let l = params.profile_half_length_m;
+            match (jumped && params.profile_fallback && *next_virtual < u32::MAX)
+                .then(|| {
+                    profile_toe(input, grid, c, along, up, l, params)
+                        .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params))
+                })
+                .flatten()
+                .filter(|t| {
+                    (t.xyz[0] - cur[0]) * along[0] + (t.xyz[1] - cur[1]) * along[1] > 0.25 * d_s
+                }) {
+                Some(toe) => {
+                    let id = *next_virtual;
+                    *next_virtual += 1;
+                    (id, toe.xyz)
+                }
+                None => (n as u32, [input.x[n], input.y[n], input.z[n]]),
+            }
         };
         let (n, p) = next;
-        if std::env::var_os("BEND_PROFILE_DEBUG").is_some() {
-            eprintln!(
-                "STEP {} {:.3} {:.3} {:.3} virt={} gap={}",
-                own,
-                p[0],
-                p[1],
-                p[2],
-                n as usize >= input.x.len(),
-                gap
-            );
-        }
         if let Some(j) = claims.near(n, p[0], p[1], own) {
             return (picked, Some(j));
         }
@@ -875,21 +886,56 @@ mod tests {
         let params = BendParams::default();
         // Across the side street's curb (x = 10) at y = 11, walking north: the curb rises
         // on the left (towards −x).
-        let toe =
-            profile_toe(&inp, &grid, [10.1, 11.0, 0.0], [0.0, 1.0], 1.0, &params).expect("a toe");
+        let toe = profile_toe(
+            &inp,
+            &grid,
+            [10.1, 11.0, 0.0],
+            [0.0, 1.0],
+            1.0,
+            0.15,
+            &params,
+        )
+        .expect("a toe");
         assert!((toe.xyz[0] - 10.0).abs() < 0.06, "{toe:?}");
         assert!((toe.step_m - 0.15).abs() < 0.01, "{toe:?}");
         // With the wrong side up there is no curb (the ground falls).
-        assert!(profile_toe(&inp, &grid, [10.1, 11.0, 0.0], [0.0, 1.0], -1.0, &params).is_none());
+        assert!(profile_toe(
+            &inp,
+            &grid,
+            [10.1, 11.0, 0.0],
+            [0.0, 1.0],
+            -1.0,
+            0.15,
+            &params
+        )
+        .is_none());
         // A flat road gives nothing.
-        assert!(profile_toe(&inp, &grid, [13.0, 2.0, 0.0], [0.0, 1.0], 1.0, &params).is_none());
+        assert!(profile_toe(
+            &inp,
+            &grid,
+            [13.0, 2.0, 0.0],
+            [0.0, 1.0],
+            1.0,
+            0.15,
+            &params
+        )
+        .is_none());
         // A 20 % ramp (z = 0.2·x) is no step.
         let ramp_z: Vec<f64> = c.x.iter().map(|&x| 0.2 * x).collect();
         let ramp = BendInput {
             z: &ramp_z,
             ..input(&c)
         };
-        assert!(profile_toe(&ramp, &grid, [13.0, 2.0, 2.6], [0.0, 1.0], 1.0, &params).is_none());
+        assert!(profile_toe(
+            &ramp,
+            &grid,
+            [13.0, 2.0, 2.6],
+            [0.0, 1.0],
+            1.0,
+            0.15,
+            &params
+        )
+        .is_none());
     }
 
     #[test]
