@@ -264,7 +264,7 @@ impl QiuParams {
                 )));
             }
         }
-        if !(self.max_step_m >= self.min_step_m) {
+        if self.max_step_m < self.min_step_m {
             return Err(QiuParamsError(format!(
                 "max_step_m must be at least min_step_m ({}), found {}",
                 self.min_step_m, self.max_step_m
