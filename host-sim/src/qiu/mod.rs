@@ -561,4 +561,134 @@ mod tests {
         };
         assert!(extract_edges(&input, &QiuParams::default()).is_empty());
     }
+
+    /// The whole `--method qiu` path from files, as `curbtrace extract` runs it: the `tiny`
+    /// scene written as LAZ (1 mm quantised, UTM-sized coordinates, GPS times near 4e8 s)
+    /// with its trajectory CSV, read back, extracted and scored against its reference at
+    /// the paper's 200 mm buffer (measured: 99.4 % / 99.2 %).
+    #[test]
+    fn tiny_scene_through_laz_file_reaches_the_targets() {
+        use crate::config::Config;
+        use crate::eval::{evaluate, EvalParams};
+        use crate::pipeline::{extract_file_with, ExtractOptions, Method, Progress};
+        let dir = tempfile::tempdir().unwrap();
+        let spec = crate::simulate::scene_by_name("tiny").unwrap();
+        crate::simulate::run(&spec, 1, None, dir.path(), false).unwrap();
+        let opts = ExtractOptions {
+            method: Method::Qiu,
+            ..ExtractOptions::default()
+        };
+        let r = extract_file_with(
+            &dir.path().join("points.laz"),
+            &dir.path().join("trajectory.csv"),
+            &Config::default(),
+            &opts,
+            &Progress::hidden(),
+        )
+        .unwrap();
+        assert!(r.edges.iter().all(|e| e.method.as_deref() == Some("qiu")));
+        let (reference, _) =
+            crate::model::read_geojson(&dir.path().join("reference.geojson")).unwrap();
+        let ev = evaluate(
+            &reference,
+            &r.edges,
+            &EvalParams {
+                buffer_m: 0.2,
+                ..EvalParams::default()
+            },
+        )
+        .unwrap();
+        let c = ev.total.completeness_pct.unwrap();
+        let p = ev.total.correctness_pct.unwrap();
+        assert!(
+            c >= 95.0 && p >= 95.0,
+            "completeness {c} %, correctness {p} %"
+        );
+    }
+
+    /// The regression behind sapporo's 39 % (file path) against 72 % (in memory): not the
+    /// file, but the choice among the refined planes. With the plain variance as E_s, a
+    /// different RANSAC draw (a new seed, or 1 mm quantisation of the same points) could let
+    /// road noise (β = 0.01 m, below the range noise) win a whole section. Here the road has
+    /// range-like noise (σ ≈ 5 mm, so β = 0.01 m leaves noise outliers all over it) and a
+    /// curb cut on the left; every seed must choose a β that sees the curb, not the noise,
+    /// and find both curbs.
+    #[test]
+    fn the_choice_of_beta_does_not_depend_on_the_ransac_draw() {
+        let len = 40.0;
+        let (mut pts, traj) = synthetic_road(len, 3);
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        for p in &mut pts {
+            // Roughly Gaussian (sum of three uniforms), σ ≈ 5 mm, on top of the 3 mm jitter.
+            let g: f64 = (0..3).map(|_| rng.gen_range(-0.0087..0.0087)).sum();
+            p[2] += g;
+            // A curb cut: the left curb lowered to 25 mm over x ∈ [15, 19].
+            let (x, y) = (p[0] - X0, p[1] - Y0);
+            if (15.0..19.0).contains(&x) && y > 5.0 - 0.02 && y < 7.9 {
+                p[2] = p[2].min(10.025 + g);
+            }
+        }
+        let col = |k: usize| pts.iter().map(|p| p[k]).collect::<Vec<f64>>();
+        let (x, y, z, t) = (col(0), col(1), col(2), col(3));
+        let input = QiuInput {
+            x: &x,
+            y: &y,
+            z: &z,
+            t: &t,
+            trajectory: &traj,
+        };
+        for seed in [1, 2, 3, 2016] {
+            let params = QiuParams {
+                seed,
+                ..QiuParams::default()
+            };
+            let (lines, rep) = extract_edges_with_report(&input, &params);
+            assert_eq!(rep.sections.len(), 1);
+            let s = &rep.sections[0];
+            for b in s.beta_m {
+                let b = b.unwrap();
+                assert!(
+                    (0.015..0.1).contains(&b),
+                    "seed {seed}: β {b}: {:?}",
+                    s.energies
+                );
+            }
+            // β = 0.01 m is noise: its spread (√E_s) is beyond the slack above the chosen
+            // one's (measured 17 and 31 mm against 0).
+            for side in 0..2 {
+                let e = |k: usize| {
+                    let r = &s.energies[k];
+                    if side == 0 {
+                        r.2.unwrap()
+                    } else {
+                        r.3.unwrap()
+                    }
+                };
+                let k = s
+                    .energies
+                    .iter()
+                    .position(|r| Some(r.0) == s.beta_m[side])
+                    .unwrap();
+                assert!(
+                    e(0).sqrt() > e(k).sqrt() + params.energy_slack_m,
+                    "side {side}: {:?}",
+                    s.energies
+                );
+            }
+            for side in [Side::Left, Side::Right] {
+                let y_ref = Y0 + if side == Side::Left { 5.0 } else { -5.0 };
+                let mine: Vec<EdgeLine> =
+                    lines.iter().filter(|l| l.side == side).cloned().collect();
+                let n = (len * 10.0) as usize;
+                let hit = (0..=n)
+                    .filter(|&k| near_any([X0 + k as f64 * 0.1, y_ref], &mine, 0.2))
+                    .count();
+                assert!(
+                    hit as f64 >= 0.85 * (n + 1) as f64,
+                    "seed {seed} {side:?}: {hit} of {}",
+                    n + 1
+                );
+            }
+        }
+    }
 }

@@ -288,7 +288,15 @@ impl Chain {
 /// The line segments of one cluster (§3.4.2 step 2): the cluster's points are ordered along
 /// its main direction (PCA), summarised every `bin_m` by the median x, y, z and station,
 /// and simplified into line segments by Douglas–Peucker. Oriented along increasing station.
-pub fn fit_segments(pts: &[EdgePoint], members: &[usize], params: &QiuParams) -> Option<Chain> {
+///
+/// `preferred` (by point index; empty: none): in a bin holding preferred points, only they
+/// give the median (the points the width step kept, where a cluster was kept whole).
+pub fn fit_segments(
+    pts: &[EdgePoint],
+    members: &[usize],
+    preferred: &[bool],
+    params: &QiuParams,
+) -> Option<Chain> {
     let n = members.len() as f64;
     let (mx, my) = members.iter().fold((0.0, 0.0), |(a, b), &i| {
         (a + pts[i].p[0] / n, b + pts[i].p[1] / n)
@@ -313,6 +321,12 @@ pub fn fit_segments(pts: &[EdgePoint], members: &[usize], params: &QiuParams) ->
     let mut verts = Vec::with_capacity(bins.len());
     let mut stations = Vec::with_capacity(bins.len());
     for b in bins.values() {
+        let pref: Vec<usize> = b
+            .iter()
+            .copied()
+            .filter(|&i| preferred.get(i).copied().unwrap_or(false))
+            .collect();
+        let b = if pref.is_empty() { b } else { &pref };
         let col = |f: &dyn Fn(&EdgePoint) -> f64| {
             let mut v: Vec<f64> = b.iter().map(|&i| f(&pts[i])).collect();
             median(&mut v).unwrap_or(f64::NAN)
@@ -423,23 +437,46 @@ pub fn keep_longest(mut chains: Vec<Chain>, params: &QiuParams) -> Vec<Chain> {
     kept
 }
 
-/// §3.4.2 steps 1–3 on the points kept by the width refinement: clusters per side, line
-/// segments per cluster, joined. Step 4 ([`keep_longest`]) follows once heights are known.
+/// §3.4.2 steps 1–3 after the width refinement (`kept`): clusters per side, line segments
+/// per cluster, joined. A cluster of which at least `cluster_keep_share` was kept by the
+/// width step is used whole (its kept points still place the line wherever they are, see
+/// [`fit_segments`]'s `preferred`); of other clusters only the kept points count. Measured
+/// on `kawasaki` (200 mm): completeness 90.1 → 93.6 % (bus bay 70 → 100 %, right-hand
+/// intersection 22 → 76 %), correctness 100 % both; at 50 mm the line is less exact where
+/// only unkept points place it (completeness 84 → 78 %). Step 4 ([`keep_longest`]) follows
+/// once heights are known.
 pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParams) -> Vec<Chain> {
+    let mut is_kept = vec![false; pts.len()];
+    for &i in kept {
+        is_kept[i] = true;
+    }
     let mut pieces = Vec::new();
     for side in [Side::Left, Side::Right] {
-        let idx: Vec<usize> = kept
-            .iter()
-            .copied()
-            .filter(|&i| pts[i].side() == side)
-            .collect();
-        let xy: Vec<[f64; 2]> = idx.iter().map(|&i| [pts[i].p[0], pts[i].p[1]]).collect();
+        // Clusters of all candidates of the side; a cluster mostly kept by the width step
+        // is kept whole, so a curb that turns a corner keeps its arc (whose offset leaves
+        // the road's width) with the straight part it is joined to; of any other cluster
+        // only the kept points count, clustered anew.
+        let all: Vec<usize> = (0..pts.len()).filter(|&i| pts[i].side() == side).collect();
+        let xy: Vec<[f64; 2]> = all.iter().map(|&i| [pts[i].p[0], pts[i].p[1]]).collect();
+        let mut groups: Vec<Vec<usize>> = Vec::new();
         for cluster in euclidean_clusters(&xy, params.cluster_tolerance_m) {
-            if cluster.len() < params.min_cluster_points {
+            let members: Vec<usize> = cluster.iter().map(|&k| all[k]).collect();
+            let n_kept = members.iter().filter(|&&i| is_kept[i]).count();
+            if n_kept as f64 >= params.cluster_keep_share * members.len() as f64 && n_kept > 0 {
+                groups.push(members);
                 continue;
             }
-            let members: Vec<usize> = cluster.iter().map(|&k| idx[k]).collect();
-            if let Some(c) = fit_segments(pts, &members, params) {
+            let sub: Vec<usize> = members.into_iter().filter(|&i| is_kept[i]).collect();
+            let sxy: Vec<[f64; 2]> = sub.iter().map(|&i| [pts[i].p[0], pts[i].p[1]]).collect();
+            for c in euclidean_clusters(&sxy, params.cluster_tolerance_m) {
+                groups.push(c.iter().map(|&k| sub[k]).collect());
+            }
+        }
+        for members in groups {
+            if members.len() < params.min_cluster_points {
+                continue;
+            }
+            if let Some(c) = fit_segments(pts, &members, &is_kept, params) {
                 pieces.push(c);
             }
         }
