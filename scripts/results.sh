@@ -17,7 +17,8 @@ run_scene() { # name [speed km/h; default: the scene's own]
     local t0 t1 s
     t0=$(date +%s%N)
     "$BIN" extract "$dir/points.laz" --trajectory "$dir/trajectory.csv" \
-      -o "$dir/$method.geojson" --method "$method" > "$dir/$method.summary.txt"
+      -o "$dir/$method.geojson" --method "$method" 2> "$dir/$method.summary.txt" \
+      || { cat "$dir/$method.summary.txt" >&2; exit 1; }
     t1=$(date +%s%N)
     s=$(( (t1 - t0) / 1000000 ))
     {
@@ -50,3 +51,5 @@ for scene in tiny curvy sapporo kawasaki; do
 done
 run_scene kawasaki 40
 echo "wrote $REPORT"
+python3 scripts/results_summary.py "$OUT" > "$OUT/summary.md"
+echo "wrote $OUT/summary.md (the tables of docs/results.md)"
