@@ -40,6 +40,12 @@ use std::path::{Path, PathBuf};
 /// 67 B per point for format 10 without extra bytes) stays a few tens of MB.
 pub const CHUNK_POINTS: u64 = 1 << 18;
 
+/// The byte slab of one `fill_points` call is at most this: a record can be up to 65 535
+/// bytes long (extra bytes), and 2^18 of those would be 17 GB (fuzz target `host_inputs`
+/// found a 2 GB slab from a 8222-byte record). Real files (20–67 B per point) never reach
+/// it, so they still decode [`CHUNK_POINTS`] at a time.
+const MAX_SLAB_BYTES: u64 = 64 << 20;
+
 /// The largest number of points one file may hand to the core: the wire's tag is the `u32`
 /// index into the columns and `u32::MAX` means "not processed" downstream.
 pub const MAX_POINTS: u64 = u32::MAX as u64 - 1;
@@ -546,6 +552,18 @@ fn parse_raw_head(path: &Path, bytes: &[u8], file_size: u64) -> Result<RawHead, 
         let mut b = [0u8; 8];
         b.copy_from_slice(&bytes[247..255]);
         let large = u64::from_le_bytes(b);
+        // LAS 1.4 §2.4: the legacy count is 0 or equal to the 64-bit one. The `las` crate
+        // reads the legacy count first and this reader the 64-bit one, so a header where
+        // they disagree would be size-checked with one and decoded with the other (fuzz
+        // target `host_inputs`: 1 checked, 16 777 217 decoded).
+        if legacy_count > 0 && large > 0 && legacy_count != large {
+            return Err(LasError::Truncated {
+                path,
+                what: format!(
+                    "corrupt header: the legacy point count ({legacy_count}) and the LAS 1.4 point count ({large}) disagree"
+                ),
+            });
+        }
         if large > 0 {
             count = large;
         }
@@ -685,9 +703,12 @@ pub fn read_points(
         (Some(_), true) => None,
     };
     let mut done: u64 = 0;
+    let chunk = (MAX_SLAB_BYTES / record_len.max(1) as u64)
+        .min(file_size / record_len.max(1) as u64 + 1)
+        .clamp(1, CHUNK_POINTS);
     loop {
         let n = reader
-            .fill_points(CHUNK_POINTS, &mut pd)
+            .fill_points(chunk.min(total.saturating_sub(done)), &mut pd)
             .map_err(|e| las_error(path, e, &format!("decoding points after point {done}")))?;
         if n == 0 {
             break;
@@ -1033,6 +1054,31 @@ pub(crate) mod tests {
             );
         }
         std::fs::write(&path, &good).unwrap();
+        assert_eq!(read(&path, None).unwrap().0.t.len(), 10);
+    }
+
+    /// Regression (fuzz target `host_inputs`, session 2): a LAS 1.4 header whose legacy and
+    /// 64-bit point counts disagree was size-checked with one and decoded with the other.
+    #[test]
+    fn disagreeing_point_counts_are_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("counts.las");
+        let pts: Vec<Point> = (0..10)
+            .map(|i| pt(500_000.0 + i as f64, 4_000_000.0, 0.0, i as f64))
+            .collect();
+        write_las(&path, 1, &pts, None);
+        let mut bytes = std::fs::read(&path).unwrap();
+        assert_eq!(u32::from_le_bytes(bytes[107..111].try_into().unwrap()), 10);
+        bytes[107..111].copy_from_slice(&16_777_217u32.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let err = read(&path, None).unwrap_err().to_string();
+        assert!(
+            err.contains("counts.las") && err.contains("(16777217)") && err.contains("(10)"),
+            "{err}"
+        );
+        // Legacy count 0 with the 64-bit count set is valid LAS 1.4.
+        bytes[107..111].copy_from_slice(&0u32.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
         assert_eq!(read(&path, None).unwrap().0.t.len(), 10);
     }
 
