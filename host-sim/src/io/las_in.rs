@@ -1020,16 +1020,23 @@ pub(crate) mod tests {
         read_points(path, &ReadOptions { scanner }, &mut |_, _| {})
     }
 
+    /// Ten points 1 m and 1 s apart written as `name` (LAS or LAZ by its extension) in
+    /// point format `format`; the path and the points.
+    fn ten_points(dir: &Path, name: &str, format: u8) -> (PathBuf, Vec<Point>) {
+        let path = dir.join(name);
+        let pts: Vec<Point> = (0..10)
+            .map(|i| pt(500_000.0 + i as f64, 4_000_000.0, 0.0, i as f64))
+            .collect();
+        write_las(&path, format, &pts, None);
+        (path, pts)
+    }
+
     /// Regression (fuzz target `host_inputs`, session 2): LAZ items whose sizes add up to 0
     /// made the `laz` crate's parallel decompressor divide by zero.
     #[test]
     fn laz_items_that_do_not_describe_the_point_record_are_an_error() {
         let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("items.laz");
-        let pts: Vec<Point> = (0..10)
-            .map(|i| pt(500_000.0 + i as f64, 4_000_000.0, 0.0, i as f64))
-            .collect();
-        write_las(&path, 6, &pts, None);
+        let (path, _) = ten_points(dir.path(), "items.laz", 6);
         let good = std::fs::read(&path).unwrap();
         let vlr = good
             .windows(14)
@@ -1062,11 +1069,7 @@ pub(crate) mod tests {
     #[test]
     fn disagreeing_point_counts_are_an_error() {
         let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("counts.las");
-        let pts: Vec<Point> = (0..10)
-            .map(|i| pt(500_000.0 + i as f64, 4_000_000.0, 0.0, i as f64))
-            .collect();
-        write_las(&path, 1, &pts, None);
+        let (path, _) = ten_points(dir.path(), "counts.las", 1);
         let mut bytes = std::fs::read(&path).unwrap();
         assert_eq!(u32::from_le_bytes(bytes[107..111].try_into().unwrap()), 10);
         bytes[107..111].copy_from_slice(&16_777_217u32.to_le_bytes());
@@ -1087,11 +1090,7 @@ pub(crate) mod tests {
     #[test]
     fn a_laz_chunk_table_claiming_more_chunks_than_bytes_is_an_error_before_any_allocation() {
         let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("chunks.laz");
-        let pts: Vec<Point> = (0..10)
-            .map(|i| pt(500_000.0 + i as f64, 4_000_000.0, 0.0, i as f64))
-            .collect();
-        write_las(&path, 6, &pts, None);
+        let (path, _) = ten_points(dir.path(), "chunks.laz", 6);
         let good = std::fs::read(&path).unwrap();
         assert_eq!(read(&path, None).unwrap().0.t.len(), 10);
         let data_start = u32::from_le_bytes(good[96..100].try_into().unwrap()) as usize;
@@ -1118,11 +1117,7 @@ pub(crate) mod tests {
     #[test]
     fn an_extended_vlr_longer_than_the_file_is_an_error_before_any_allocation() {
         let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("evlr.las");
-        let pts: Vec<Point> = (0..10)
-            .map(|i| pt(500_000.0 + i as f64, 4_000_000.0, 0.0, i as f64))
-            .collect();
-        write_las(&path, 6, &pts, None);
+        let (path, pts) = ten_points(dir.path(), "evlr.las", 6);
         let mut bytes = std::fs::read(&path).unwrap();
         let end = bytes.len() as u64;
         // One EVLR right after the points, claiming 2^62 bytes.
