@@ -265,12 +265,32 @@ fn judge(x: &[f32], z: &[f32], i: usize, so: usize, to: usize, thr: Threshold) -
         return PointStatus::NonFinite;
     }
     // An isolated point (nothing within d_b on either side: a spike taller than d_b)
-    // is judged by its adjacent points instead, or it could never be removed.
-    let (sj, tj) = if so == 0 && to == 0 && i > 0 && i + 1 < n {
-        (i - 1, i + 1)
+    // is judged by its adjacent points instead, or it could never be removed. Rare: out
+    // of line, so the common path keeps its registers.
+    if so | to == 0 {
+        return judge_isolated(x, z, i, thr);
+    }
+    judge_with(x, z, i, i - so, i + to, thr)
+}
+
+/// [`judge`] of a point with no neighbour within d_b on either side (already known to be
+/// in range): by its adjacent points, if it has both.
+#[cold]
+#[inline(never)]
+fn judge_isolated(x: &[f32], z: &[f32], i: usize, thr: Threshold) -> PointStatus {
+    if i > 0 && i + 1 < x.len() {
+        judge_with(x, z, i, i - 1, i + 1, thr)
     } else {
-        (i - so, i + to)
-    };
+        PointStatus::Kept
+    }
+}
+
+/// The irregular test of point `i` (in range) with neighbours `sj` and `tj`.
+#[inline(always)]
+fn judge_with(x: &[f32], z: &[f32], i: usize, sj: usize, tj: usize, thr: Threshold) -> PointStatus {
+    let n = x.len();
+    let z = &z[..n];
+    let (xi, zi) = (x[i], z[i]);
     let (ax, az) = (xi - x[sj], zi - z[sj]);
     let (bx, bz) = (x[tj] - xi, z[tj] - zi);
     let c = ax * bz - az * bx;
@@ -344,6 +364,69 @@ fn windows_sweeps_marked(
         non_finite += u32::from(st == PointStatus::NonFinite);
     }
     (capped, irregular, non_finite)
+}
+
+/// [`windows`] and then [`bend_angles`] on the (smoothed) line: returns the capped
+/// windows. On the M4F ρ is computed inside the backward sweep, while p_j and its window
+/// are still in registers; elsewhere it is the two calls. The same values either way
+/// (tested).
+pub(crate) fn windows_angles<M: Backend>(
+    x: &[f32],
+    z: &[f32],
+    d2: f32,
+    s_off: &mut [u8],
+    t_off: &mut [u8],
+    rho: &mut [f32],
+) -> u32 {
+    if cfg!(target_pointer_width = "64") {
+        let capped = windows(x, z, d2, s_off, t_off);
+        bend_angles::<M>(x, z, s_off, t_off, rho);
+        capped
+    } else {
+        windows_sweeps_angles::<M>(x, z, d2, s_off, t_off, rho)
+    }
+}
+
+/// [`windows_sweeps`] with [`bend_angles`] in the backward sweep.
+#[inline(never)] // its own registers (see `mark_irregular`)
+#[cfg_attr(all(not(test), target_pointer_width = "64"), allow(dead_code))]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN counts as beyond, as in `beyond`
+fn windows_sweeps_angles<M: Backend>(
+    x: &[f32],
+    z: &[f32],
+    d2: f32,
+    s_off: &mut [u8],
+    t_off: &mut [u8],
+    rho: &mut [f32],
+) -> u32 {
+    let n = x.len();
+    let (z, s_off, t_off, rho) = (&z[..n], &mut s_off[..n], &mut t_off[..n], &mut rho[..n]);
+    let mut capped = forward_sweep(x, z, d2, s_off);
+    let mut t = n.saturating_sub(1);
+    for j in (0..n).rev() {
+        let (xj, zj) = (x[j], z[j]);
+        let far = |k: usize| {
+            let (dx, dz) = (x[k] - xj, z[k] - zj);
+            !(dx * dx + dz * dz <= d2)
+        };
+        if t - j > MAX_SIDE {
+            t = j + MAX_SIDE;
+            if !far(t + 1) {
+                capped += 1;
+            }
+        }
+        while t > j && far(t) {
+            t -= 1;
+        }
+        t_off[j] = (t - j) as u8;
+        let s = j - usize::from(s_off[j]);
+        rho[j] = if s == j || t == j {
+            0.0
+        } else {
+            bend_angle_deg::<M>(x, z, s, j, t)
+        };
+    }
+    capped
 }
 
 /// Bit pattern of [`MAX_COORD_M`].
@@ -547,6 +630,27 @@ mod tests {
                 assert_eq!(r3, (c1, i1, n1), "case {case} d2 {d2}");
                 assert_eq!((s3, t3), (s1, t1));
                 assert_eq!(st3[..n], st1[..n], "case {case} d2 {d2}");
+                // The fused angles give what the separate pass gives.
+                let mut rho1 = [0f32; N];
+                bend_angles::<Selected>(&x[..n], &z[..n], &s1, &t1, &mut rho1[..n]);
+                let (mut s4, mut t4, mut rho4) = ([0u8; N], [0u8; N], [0f32; N]);
+                let c4 = windows_sweeps_angles::<Selected>(
+                    &x[..n],
+                    &z[..n],
+                    d2,
+                    &mut s4,
+                    &mut t4,
+                    &mut rho4[..n],
+                );
+                assert_eq!(c4, c1, "case {case} d2 {d2}");
+                assert_eq!((s4, t4), (s1, t1));
+                for i in 0..n {
+                    let (a, b) = (rho1[i], rho4[i]);
+                    assert!(
+                        a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                        "case {case} d2 {d2} i {i}: {a} {b}"
+                    );
+                }
                 if case % 3 == 1 && n == N {
                     assert!(n1 > 0, "NaN points are marked");
                 }

@@ -279,8 +279,8 @@ impl<const N: usize> Kernel<N> {
 
         // 4. ρ on the smoothed line.
         let s_off = &mut s_off[..kept];
-        c.capped_windows += bend::windows(xk, zk, d2, s_off, &mut aux[..kept]);
-        bend::bend_angles::<M>(xk, zk, s_off, &aux[..kept], &mut rho[..kept]);
+        c.capped_windows +=
+            bend::windows_angles::<M>(xk, zk, d2, s_off, &mut aux[..kept], &mut rho[..kept]);
         rho[kept..].fill(0.0);
 
         // 5. §2.6: nadir, peaks, candidates (compact indices).
