@@ -26,7 +26,8 @@ compile_error!(
 /// features can run the same line through both (the micromath tolerance test); everything
 /// else calls the free functions below.
 pub(crate) trait Backend {
-    /// Four-quadrant arctangent of `y / x`, radians in (−π, π].
+    /// Four-quadrant arctangent of `y / x`, radians in [−π, π]; +0 for x = y = ±0 (the
+    /// bend angle relies on it).
     fn atan2(y: f32, x: f32) -> f32;
     /// Sine of `x` radians.
     fn sin(x: f32) -> f32;
@@ -158,7 +159,9 @@ mod tests {
         assert!((atan2(1.0, 0.0) * deg - 90.0).abs() < 0.2);
         assert!((atan2(1.0, 1.0) * deg - 45.0).abs() < 0.2);
         assert!((atan2(-1.0, -1.0) * deg + 135.0).abs() < 0.2);
-        assert_eq!(atan2(0.0, 0.0), 0.0);
+        for (y, x) in [(0.0f32, 0.0f32), (-0.0, 0.0), (0.0, -0.0), (-0.0, -0.0)] {
+            assert_eq!(atan2(y, x).to_bits(), 0, "atan2({y}, {x}) is +0");
+        }
         assert!((cos(core::f32::consts::FRAC_PI_3) - 0.5).abs() < 2e-3);
         assert!((sin(core::f32::consts::FRAC_PI_6) - 0.5).abs() < 2e-3);
         assert_eq!(abs(-2.5), 2.5);

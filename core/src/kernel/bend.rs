@@ -448,10 +448,8 @@ pub(crate) fn bend_angle_deg<M: Backend>(
     let (bx, bz) = (xt - xi, zt - zi);
     let c = ax * bz - az * bx;
     let d = ax * bx + az * bz;
-    if c == 0.0 && d == 0.0 {
-        // A neighbour coincides with p_i: no direction, no bend.
-        return 0.0;
-    }
+    // c = d = 0 (a neighbour coincides with p_i: no direction) gives ρ = 0: every
+    // backend's atan2(±0, ±0) is +0 (see `math::Backend`).
     let side_o = xs * zt - zs * xt;
     let cs = if side_o > 0.0 {
         c

@@ -305,6 +305,7 @@ fn smooth_piece(v: &mut [f32], scratch: &mut [f32], steps: u32, b: &Block) {
 /// points are more than `gap_m` apart; `gap_m` ≤ 0 never splits). `scratch` must be at
 /// least as long as the line (the per-step form ping-pongs through it). Returns the number
 /// of pieces.
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // a NaN distance does not split, as before
 pub(crate) fn taubin_smooth(
     x: &mut [f32],
     z: &mut [f32],
@@ -322,19 +323,21 @@ pub(crate) fn taubin_smooth(
     let mut pieces = 0;
     let mut start = 0;
     while start < n {
-        let mut end = start + 1;
-        if split {
-            while end < n {
-                let dx = x[end] - x[end - 1];
-                let dz = z[end] - z[end - 1];
-                if dx * dx + dz * dz > gap2 {
-                    break;
-                }
-                end += 1;
-            }
+        let end = if split {
+            // Pairs of consecutive points as slice windows: the M4F walks two pointers
+            // instead of indexing four values per point.
+            let pairs = x[start..].windows(2).zip(z[start..].windows(2));
+            start
+                + 1
+                + pairs
+                    .take_while(|(px, pz)| {
+                        let (dx, dz) = (px[1] - px[0], pz[1] - pz[0]);
+                        !(dx * dx + dz * dz > gap2)
+                    })
+                    .count()
         } else {
-            end = n;
-        }
+            n
+        };
         smooth_piece(&mut x[start..end], scratch, steps, &b);
         smooth_piece(&mut z[start..end], scratch, steps, &b);
         pieces += 1;
