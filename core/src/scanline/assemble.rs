@@ -330,7 +330,54 @@ impl<const N: usize> Assembler<N> {
     }
 
     /// Offers the next point (absolute time `t_ns`, finite x′/z′ — the wire guarantees it).
+    #[inline(always)]
     pub fn offer(&mut self, t_ns: u64, p: &PointRecord) -> Offer {
+        // The common case first, in as few instructions as it takes: a point that
+        // continues an open, non-empty line within capacity, without a flag, a time gap
+        // or a side change. Every rule of `offer_general` then comes out the same: no
+        // split (no flag, no gap, no crossing to be a zenith), nothing to reset, no
+        // arming, the line already has its index and start time; what is left is the
+        // rotation vote, the previous-point state and the push (tested against the
+        // general path).
+        let (x, z) = (p.x_m, p.z_m);
+        let len = self.line.len;
+        if !self.closed && !self.reset && !p.line_start && len > 0 && len < N {
+            if let (Some(lt), Some((xa, za)), Some((xs, _))) =
+                (self.last_t, self.last_pt, self.last_side_pt)
+            {
+                if lt.abs_diff(t_ns) <= self.params.gap_ns && (x > 0.0) == (xs > 0.0) {
+                    self.vote_on(xa, za, x, z);
+                    self.last_pt = Some((x, z));
+                    if x != 0.0 {
+                        self.last_side_pt = Some((x, z));
+                    }
+                    self.last_t = Some(t_ns);
+                    let line = &mut self.line;
+                    line.x_m[len] = x;
+                    line.z_m[len] = z;
+                    line.tag[len] = p.tag;
+                    line.len = len + 1;
+                    return Offer::Taken;
+                }
+            }
+        }
+        self.offer_general(t_ns, p)
+    }
+
+    /// The rotation vote of the step from (xa, za) to (x, z).
+    #[inline(always)]
+    fn vote_on(&mut self, xa: f32, za: f32, x: f32, z: f32) {
+        let c = xa * z - za * x;
+        if c > 0.0 {
+            self.vote = (self.vote + 1).min(VOTE_CLAMP);
+        } else if c < 0.0 {
+            self.vote = (self.vote - 1).max(-VOTE_CLAMP);
+        }
+    }
+
+    /// [`Self::offer`] in full: every split rule and every state change.
+    #[inline(never)]
+    fn offer_general(&mut self, t_ns: u64, p: &PointRecord) -> Offer {
         if self.closed {
             self.line.clear();
             self.closed = false;
@@ -372,12 +419,7 @@ impl<const N: usize> Assembler<N> {
             Crossing::None => {}
         }
         if let Some((xa, za)) = self.last_pt {
-            let c = xa * p.z_m - za * p.x_m;
-            if c > 0.0 {
-                self.vote = (self.vote + 1).min(VOTE_CLAMP);
-            } else if c < 0.0 {
-                self.vote = (self.vote - 1).max(-VOTE_CLAMP);
-            }
+            self.vote_on(xa, za, p.x_m, p.z_m);
         }
         self.last_pt = Some((p.x_m, p.z_m));
         if p.x_m != 0.0 {
