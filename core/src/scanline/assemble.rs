@@ -155,28 +155,32 @@ enum Crossing {
 }
 
 /// Cuts a stream of points into [`Line`]s of at most `N` points.
+// `repr(C)`, the per-point state first and the line last (its own per-point fields lead
+// it): every field the fast path of `offer` touches lies within an immediate offset of
+// the assembler's start on the Cortex-M4F (see [`Line`]).
+#[repr(C)]
 pub struct Assembler<const N: usize> {
-    line: Line<N>,
-    params: SplitParams,
-    counters: AssembleCounters,
-    /// Index the next line will get.
-    next_index: u32,
     /// The current line is complete (returned by a split or close) and not yet cleared.
     closed: bool,
     /// Forget the previous point before taking the next (after a gap or the end).
     reset: bool,
-    /// Time of the previous point.
-    last_t: Option<u64>,
-    /// Previous point (x′, z′), for the rotation vote.
-    last_pt: Option<(f32, f32)>,
-    /// Last point with x′ ≠ 0, for side changes.
-    last_side_pt: Option<(f32, f32)>,
-    /// Rotation-sense vote (+ = counter-clockwise in the x′–z′ plane).
-    vote: i32,
     /// A zenith crossing may split (see the module docs).
     armed: bool,
     /// A line-start flag has been seen in the stream.
     seen_flag: bool,
+    /// Rotation-sense vote (+ = counter-clockwise in the x′–z′ plane).
+    vote: i32,
+    /// Previous point (x′, z′), for the rotation vote.
+    last_pt: Option<(f32, f32)>,
+    /// Last point with x′ ≠ 0, for side changes.
+    last_side_pt: Option<(f32, f32)>,
+    /// Time of the previous point.
+    last_t: Option<u64>,
+    params: SplitParams,
+    /// Index the next line will get.
+    next_index: u32,
+    counters: AssembleCounters,
+    line: Line<N>,
 }
 
 impl<const N: usize> Assembler<N> {

@@ -48,21 +48,25 @@ pub use ingest::{Ingest, IngestCounters, IngestEvent};
 ///
 /// Capacity `N` is the largest number of points one line can hold (`MAX_POINTS`); points
 /// beyond it are counted in [`Line::truncated`], never stored.
+// `repr(C)` with the arrays last: the per-point fields (`len`, `truncated`) then sit at
+// small offsets from the line's start, which a Cortex-M4F load or store reaches with an
+// immediate offset; behind 24 KiB of arrays each access needs an extra instruction.
+#[repr(C)]
 pub struct Line<const N: usize> {
+    /// Number of valid points (`0..=N`).
+    pub len: usize,
+    /// Scanline number in the stream (0, 1, 2, … in order of completion).
+    pub index: u32,
+    /// Points of this line that did not fit into `N` and were dropped (counted, not stored).
+    pub truncated: u32,
+    /// Absolute time of the first point, nanoseconds (the wire's time base).
+    pub start_time_ns: u64,
     /// x′ in metres (signed lateral offset from the scanner, left positive).
     pub x_m: [f32; N],
     /// z′ in metres (height relative to the scanner origin).
     pub z_m: [f32; N],
     /// Pass-through tags from the wire, one per point, joining results to source points.
     pub tag: [u32; N],
-    /// Number of valid points (`0..=N`).
-    pub len: usize,
-    /// Scanline number in the stream (0, 1, 2, … in order of completion).
-    pub index: u32,
-    /// Absolute time of the first point, nanoseconds (the wire's time base).
-    pub start_time_ns: u64,
-    /// Points of this line that did not fit into `N` and were dropped (counted, not stored).
-    pub truncated: u32,
 }
 
 impl<const N: usize> Line<N> {
