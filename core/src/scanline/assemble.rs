@@ -520,6 +520,76 @@ mod tests {
         lines
     }
 
+    /// The fast path of `offer` decides exactly as the general rules: two assemblers fed
+    /// the same odd stream (flags, time gaps both ways, side changes, x′ = 0, points over
+    /// capacity, closes), one through `offer`, one through `offer_general` only, give the
+    /// same answers, lines and counters.
+    #[test]
+    fn fast_path_is_the_general_rules() {
+        let mut r = 7u64;
+        let mut u = || {
+            r = r
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((r >> 40) as f32) / ((1u64 << 24) as f32)
+        };
+        for geometry in [
+            GeometrySplit::Auto,
+            GeometrySplit::Always,
+            GeometrySplit::Never,
+        ] {
+            let mut a = Assembler::<64>::new();
+            let mut b = Assembler::<64>::new();
+            let params = SplitParams {
+                gap_ns: 5_000,
+                geometry,
+            };
+            a.set_params(params);
+            b.set_params(params);
+            let mut t = 1_000_000u64;
+            let (mut fast, mut splits) = (0, 0);
+            for k in 0..20_000u32 {
+                let v = u();
+                t = if v < 0.01 {
+                    t + 10_000 // gap
+                } else if v < 0.015 {
+                    t - 20_000 // jump back
+                } else {
+                    t + 1_000
+                };
+                let ang = u() * 6.3;
+                let mut p = pt(5.0 * libm::sinf(ang), 5.0 * libm::cosf(ang), k);
+                if u() < 0.05 {
+                    p.x_m = 0.0;
+                }
+                p.line_start = u() < 0.002;
+                if u() < 0.001 {
+                    assert_eq!(a.close(SplitReason::SeqGap), b.close(SplitReason::SeqGap));
+                }
+                let before = (a.closed, a.reset, a.line.len);
+                let ra = a.offer(t, &p);
+                let rb = b.offer_general(t, &p);
+                assert_eq!(ra, rb, "point {k}");
+                if !before.0 && !before.1 && before.2 > 0 && ra == Offer::Taken {
+                    fast += 1;
+                }
+                if let Offer::Split(_) = ra {
+                    splits += 1;
+                    assert_eq!(a.line.len, b.line.len);
+                    assert_eq!(a.line.x_m[..a.line.len], b.line.x_m[..b.line.len]);
+                    assert_eq!(a.line.tag[..a.line.len], b.line.tag[..b.line.len]);
+                    assert_eq!(a.offer(t, &p), b.offer_general(t, &p));
+                }
+                assert_eq!(a.counters(), b.counters(), "point {k}");
+                assert_eq!(a.rotation_sense(), b.rotation_sense());
+            }
+            assert!(
+                fast > 10_000 && splits > 50,
+                "{geometry:?}: {fast} {splits}"
+            );
+        }
+    }
+
     /// Every combination of rotation direction and returns above: one line per revolution,
     /// each starting with the revolution's first return.
     #[test]
