@@ -248,9 +248,11 @@ fn fused_block<const K: usize>(v: &mut [f32], b: &Block) {
     // point still to be read.
     let mut t = K + 1;
     while t + 2 < n {
-        v[t - K] = g * tick::<0, K>(&mut w, &r, v[t]);
-        v[t + 1 - K] = g * tick::<1, K>(&mut w, &r, v[t + 1]);
-        v[t + 2 - K] = g * tick::<2, K>(&mut w, &r, v[t + 2]);
+        // One window per three points: reads at K.., writes at 0..3, one bounds check.
+        let win = &mut v[t - K..t + 3];
+        win[0] = g * tick::<0, K>(&mut w, &r, win[K]);
+        win[1] = g * tick::<1, K>(&mut w, &r, win[K + 1]);
+        win[2] = g * tick::<2, K>(&mut w, &r, win[K + 2]);
         t += 3;
     }
     let st = if t < n {
