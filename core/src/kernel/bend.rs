@@ -273,6 +273,43 @@ fn judge(x: &[f32], z: &[f32], i: usize, so: usize, to: usize, thr: Threshold) -
     judge_with(x, z, i, i - so, i + to, thr)
 }
 
+/// [`judge`] with b = p_t − p_i already computed (by the backward sweep).
+#[inline(always)]
+fn judge_b(
+    x: &[f32],
+    z: &[f32],
+    i: usize,
+    so: usize,
+    to: usize,
+    b: (f32, f32),
+    thr: Threshold,
+) -> PointStatus {
+    let (xi, zi) = (x[i], z[i]);
+    let mag = (xi.to_bits() & 0x7FFF_FFFF).max(zi.to_bits() & 0x7FFF_FFFF);
+    if mag > MAX_COORD_BITS {
+        return PointStatus::NonFinite;
+    }
+    if so | to == 0 {
+        return judge_isolated(x, z, i, thr);
+    }
+    let sj = i - so;
+    let (ax, az) = (xi - x[sj], zi - z[sj]);
+    irregular_test(ax, az, b.0, b.1, thr)
+}
+
+/// The irregular test on a = p_i − p_s, b = p_t − p_i (see [`mark_irregular`]).
+#[inline(always)]
+fn irregular_test(ax: f32, az: f32, bx: f32, bz: f32, thr: Threshold) -> PointStatus {
+    let c = ax * bz - az * bx;
+    let d = ax * bx + az * bz;
+    // With s == i or t == i, c = d = 0 and the test is false: kept.
+    if math::abs(c) * thr.cos - d * thr.sin > 0.0 {
+        PointStatus::Irregular
+    } else {
+        PointStatus::Kept
+    }
+}
+
 /// [`judge`] of a point with no neighbour within d_b on either side (already known to be
 /// in range): by its adjacent points, if it has both.
 #[cold]
@@ -293,14 +330,7 @@ fn judge_with(x: &[f32], z: &[f32], i: usize, sj: usize, tj: usize, thr: Thresho
     let (xi, zi) = (x[i], z[i]);
     let (ax, az) = (xi - x[sj], zi - z[sj]);
     let (bx, bz) = (x[tj] - xi, z[tj] - zi);
-    let c = ax * bz - az * bx;
-    let d = ax * bx + az * bz;
-    // With s == i or t == i, c = d = 0 and the test is false: kept.
-    if math::abs(c) * thr.cos - d * thr.sin > 0.0 {
-        PointStatus::Irregular
-    } else {
-        PointStatus::Kept
-    }
+    irregular_test(ax, az, bx, bz, thr)
 }
 
 /// [`windows`] and then [`mark_irregular`] on the raw line: returns (capped windows,
@@ -354,11 +384,19 @@ fn windows_sweeps_marked(
                 capped += 1;
             }
         }
-        while t > j && far(t) {
+        // The walk, keeping p_t − p_j from its last distance test: the judgement's b,
+        // the same bits it would compute ((0, 0) when t = j, as x_j − x_j).
+        let (mut bx, mut bz) = (0.0f32, 0.0f32);
+        while t > j {
+            let (dx, dz) = (x[t] - xj, z[t] - zj);
+            if dx * dx + dz * dz <= d2 {
+                (bx, bz) = (dx, dz);
+                break;
+            }
             t -= 1;
         }
         t_off[j] = (t - j) as u8;
-        let st = judge(x, z, j, usize::from(s_off[j]), t - j, thr);
+        let st = judge_b(x, z, j, usize::from(s_off[j]), t - j, (bx, bz), thr);
         status[j] = st;
         irregular += u32::from(st == PointStatus::Irregular);
         non_finite += u32::from(st == PointStatus::NonFinite);
