@@ -453,7 +453,14 @@ fn windows_sweeps_angles<M: Backend>(
                 capped += 1;
             }
         }
-        while t > j && far(t) {
+        // The walk, keeping p_t − p_j from its last distance test (ρ's b, same bits).
+        let (mut bx, mut bz) = (0.0f32, 0.0f32);
+        while t > j {
+            let (dx, dz) = (x[t] - xj, z[t] - zj);
+            if dx * dx + dz * dz <= d2 {
+                (bx, bz) = (dx, dz);
+                break;
+            }
             t -= 1;
         }
         t_off[j] = (t - j) as u8;
@@ -461,7 +468,7 @@ fn windows_sweeps_angles<M: Backend>(
         rho[j] = if s == j || t == j {
             0.0
         } else {
-            bend_angle_deg::<M>(x, z, s, j, t)
+            bend_angle_deg_b::<M>(x, z, s, j, t, (bx, bz))
         };
     }
     capped
@@ -481,9 +488,22 @@ pub(crate) fn bend_angle_deg<M: Backend>(
     i: usize,
     t: usize,
 ) -> f32 {
+    bend_angle_deg_b::<M>(x, z, s, i, t, (x[t] - x[i], z[t] - z[i]))
+}
+
+/// [`bend_angle_deg`] with b = p_t − p_i already computed (by the backward sweep).
+#[inline(always)]
+fn bend_angle_deg_b<M: Backend>(
+    x: &[f32],
+    z: &[f32],
+    s: usize,
+    i: usize,
+    t: usize,
+    b: (f32, f32),
+) -> f32 {
     let (xs, zs, xi, zi, xt, zt) = (x[s], z[s], x[i], z[i], x[t], z[t]);
     let (ax, az) = (xi - xs, zi - zs);
-    let (bx, bz) = (xt - xi, zt - zi);
+    let (bx, bz) = b;
     let c = ax * bz - az * bx;
     let d = ax * bx + az * bz;
     // c = d = 0 (a neighbour coincides with p_i: no direction) gives ρ = 0: every
