@@ -306,27 +306,7 @@ impl<const N: usize> Kernel<N> {
                 *st = status_of(a);
             }
         } else {
-            // Points before `first_out` never moved (w = i there).
-            let mut w = kept;
-            let mut map = idx;
-            for i in (first_out..n).rev() {
-                if status[i] == PointStatus::Kept {
-                    w -= 1;
-                    x.swap(w, i);
-                    z.swap(w, i);
-                    rho.swap(w, i);
-                    status[i] = status_of(aux[w]);
-                    for (m, o) in map.iter_mut().zip(idx.iter()) {
-                        if *o == Some(w) {
-                            *m = Some(i);
-                        }
-                    }
-                }
-            }
-            for (st, &a) in status[..first_out].iter_mut().zip(aux.iter()) {
-                *st = status_of(a);
-            }
-            idx = map;
+            idx = unpartition(x, z, rho, status, aux, first_out, kept, idx);
         }
         let [nadir, left, right] = idx.map(|o| o.map(|i| i as u16));
 
@@ -346,6 +326,47 @@ impl<const N: usize> Kernel<N> {
             counters: c,
         }
     }
+}
+
+/// Step 6 of [`Kernel::process`] when points were set aside: replays the partition's swaps
+/// backwards (points before `first_out` never moved), sets the kept points' statuses from
+/// `aux`, and maps the compact indices `idx` back to input indices.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)] // its own registers: inlined, it spilled the peak search's
+fn unpartition(
+    x: &mut [f32],
+    z: &mut [f32],
+    rho: &mut [f32],
+    status: &mut [PointStatus],
+    aux: &[u8],
+    first_out: usize,
+    kept: usize,
+    idx: [Option<usize>; 3],
+) -> [Option<usize>; 3] {
+    let n = status.len();
+    let (x, z, rho) = (&mut x[..n], &mut z[..n], &mut rho[..n]);
+    // The indices to map as plain integers (`usize::MAX`: none): cheaper to compare.
+    let want = idx.map(|o| o.unwrap_or(usize::MAX));
+    let mut w = kept;
+    let mut map = idx;
+    for i in (first_out..n).rev() {
+        if status[i] == PointStatus::Kept {
+            w -= 1;
+            x.swap(w, i);
+            z.swap(w, i);
+            rho.swap(w, i);
+            status[i] = status_of(aux[w]);
+            for (m, &o) in map.iter_mut().zip(want.iter()) {
+                if o == w {
+                    *m = Some(i);
+                }
+            }
+        }
+    }
+    for (st, &a) in status[..first_out].iter_mut().zip(aux.iter()) {
+        *st = status_of(a);
+    }
+    map
 }
 
 /// The status a kept point's `u8` in the working buffer stands for.
