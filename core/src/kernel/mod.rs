@@ -255,14 +255,7 @@ impl<const N: usize> Kernel<N> {
             n
         };
         if kept < n {
-            let mut w = first_out;
-            for (i, st) in status.iter().enumerate().skip(first_out + 1) {
-                if *st == PointStatus::Kept {
-                    x.swap(w, i);
-                    z.swap(w, i);
-                    w += 1;
-                }
-            }
+            partition(x, z, status, first_out);
         }
 
         // 3. §2.5 on the kept points; ρ's buffer is the scratch.
@@ -324,6 +317,22 @@ impl<const N: usize> Kernel<N> {
             right,
             truncated: line.truncated,
             counters: c,
+        }
+    }
+}
+
+/// Step 2 of [`Kernel::process`]: the kept points to the front, in order (a Lomuto
+/// partition from the first set-aside point, `first_out`).
+#[inline(never)] // its own registers, as `unpartition`
+fn partition(x: &mut [f32], z: &mut [f32], status: &[PointStatus], first_out: usize) {
+    let n = status.len();
+    let (x, z) = (&mut x[..n], &mut z[..n]);
+    let mut w = first_out;
+    for (i, st) in status.iter().enumerate().skip(first_out + 1) {
+        if *st == PointStatus::Kept {
+            x.swap(w, i);
+            z.swap(w, i);
+            w += 1;
         }
     }
 }
