@@ -117,9 +117,10 @@ fn forward_sweep(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8]) -> u32 {
             let (dx, dz) = (x[j] - xi, z[j] - zi);
             !(dx * dx + dz * dz <= d2)
         };
-        // s ≤ i: max(s, i − MAX_SIDE) without the saturating subtraction.
+        // s ≤ i: max(s, i − MAX_SIDE) without the saturating subtraction; rare (runs of
+        // returns on one spot), so out of the way of the common path.
         if i - s > MAX_SIDE {
-            s = i - MAX_SIDE;
+            s = side_cap(i);
         }
         while s < i && far(s) {
             s += 1;
@@ -131,6 +132,13 @@ fn forward_sweep(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8]) -> u32 {
         }
     }
     capped
+}
+
+/// i − [`MAX_SIDE`]: the forward window's cap, out of line (see [`forward_sweep`]).
+#[cold]
+#[inline(never)]
+fn side_cap(i: usize) -> usize {
+    i - MAX_SIDE
 }
 
 /// [`windows`] with the forward and the backward sweep in one loop.
