@@ -88,10 +88,9 @@ fn windows_sweeps(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8], t_off: &mut [
         };
         // j ≤ t: min(t, j + MAX_SIDE) as a comparison of the offset.
         if t - j > MAX_SIDE {
-            t = j + MAX_SIDE;
-            if !far(t + 1) {
-                capped += 1;
-            }
+            let (cap, stopped) = back_cap(x, z, d2, j);
+            t = cap;
+            capped += stopped;
         }
         while t > j && far(t) {
             t -= 1;
@@ -139,6 +138,18 @@ fn forward_sweep(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8]) -> u32 {
 #[inline(never)]
 fn side_cap(i: usize) -> usize {
     i - MAX_SIDE
+}
+
+/// The backward window's cap at point `j`, out of line (rare: runs of returns on one
+/// spot): t = j + [`MAX_SIDE`], and 1 if the next point is still within d_b (a capped
+/// window), else 0.
+#[cold]
+#[inline(never)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN counts as beyond, as in `beyond`
+fn back_cap(x: &[f32], z: &[f32], d2: f32, j: usize) -> (usize, u32) {
+    let t = j + MAX_SIDE;
+    let (dx, dz) = (x[t + 1] - x[j], z[t + 1] - z[j]);
+    (t, u32::from(dx * dx + dz * dz <= d2))
 }
 
 /// [`windows`] with the forward and the backward sweep in one loop.
@@ -382,15 +393,10 @@ fn windows_sweeps_marked(
     let mut t = n.saturating_sub(1);
     for j in (0..n).rev() {
         let (xj, zj) = (x[j], z[j]);
-        let far = |k: usize| {
-            let (dx, dz) = (x[k] - xj, z[k] - zj);
-            !(dx * dx + dz * dz <= d2)
-        };
         if t - j > MAX_SIDE {
-            t = j + MAX_SIDE;
-            if !far(t + 1) {
-                capped += 1;
-            }
+            let (cap, stopped) = back_cap(x, z, d2, j);
+            t = cap;
+            capped += stopped;
         }
         // The walk, keeping p_t − p_j from its last distance test: the judgement's b,
         // the same bits it would compute ((0, 0) when t = j, as x_j − x_j).
@@ -451,15 +457,10 @@ fn windows_sweeps_angles<M: Backend>(
     let mut t = n.saturating_sub(1);
     for j in (0..n).rev() {
         let (xj, zj) = (x[j], z[j]);
-        let far = |k: usize| {
-            let (dx, dz) = (x[k] - xj, z[k] - zj);
-            !(dx * dx + dz * dz <= d2)
-        };
         if t - j > MAX_SIDE {
-            t = j + MAX_SIDE;
-            if !far(t + 1) {
-                capped += 1;
-            }
+            let (cap, stopped) = back_cap(x, z, d2, j);
+            t = cap;
+            capped += stopped;
         }
         // The walk, keeping p_t − p_j from its last distance test (ρ's b, same bits).
         let (mut bx, mut bz) = (0.0f32, 0.0f32);
