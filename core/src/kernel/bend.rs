@@ -126,8 +126,8 @@ fn forward_sweep(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8]) -> u32 {
         }
         let off = i - s;
         s_off[i] = off as u8;
-        if off == MAX_SIDE && s > 0 && !far(s - 1) {
-            capped += 1;
+        if off == MAX_SIDE {
+            capped += fwd_capped(x, z, d2, s, i);
         }
     }
     capped
@@ -138,6 +138,19 @@ fn forward_sweep(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8]) -> u32 {
 #[inline(never)]
 fn side_cap(i: usize) -> usize {
     i - MAX_SIDE
+}
+
+/// Whether the forward window of `i`, stopped at s = i − [`MAX_SIDE`], is capped: 1 if
+/// the point before s is still within d_b of p_i, else 0. Out of line (rare).
+#[cold]
+#[inline(never)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN counts as beyond, as in `beyond`
+fn fwd_capped(x: &[f32], z: &[f32], d2: f32, s: usize, i: usize) -> u32 {
+    if s == 0 {
+        return 0;
+    }
+    let (dx, dz) = (x[s - 1] - x[i], z[s - 1] - z[i]);
+    u32::from(dx * dx + dz * dz <= d2)
 }
 
 /// The backward window's cap at point `j`, out of line (rare: runs of returns on one
