@@ -79,15 +79,16 @@ pub(crate) fn seed_candidates(
     for k in 0..n {
         let s = k - usize::from(s_off[k]);
         let t = k + usize::from(aux[k]);
-        let no_neighbour = s == k || t == k;
-        out.no_neighbour += u32::from(no_neighbour);
-        aux[k] = if no_neighbour {
-            PointStatus::NoNeighbour as u8
-        } else {
-            PointStatus::Kept as u8
-        };
+        // No neighbour on a side: rare (line ends, isolated points), so a branch rather
+        // than a branch-free count.
+        if s == k || t == k {
+            aux[k] = PointStatus::NoNeighbour as u8;
+            out.no_neighbour += 1;
+            continue;
+        }
+        aux[k] = PointStatus::Kept as u8;
         let r = rho[k];
-        if no_neighbour || !(r > tau_min && r < tau_max) {
+        if !(r > tau_min && r < tau_max) {
             continue;
         }
         // The window maximum over [s, t].
