@@ -425,8 +425,11 @@ fn windows_sweeps_marked(
         t_off[j] = (t - j) as u8;
         let st = judge_b(x, z, j, usize::from(s_off[j]), t - j, (bx, bz), thr);
         status[j] = st;
-        irregular += u32::from(st == PointStatus::Irregular);
-        non_finite += u32::from(st == PointStatus::NonFinite);
+        // Set-aside points are rare: a branch, not two branch-free counts per point.
+        if st != PointStatus::Kept {
+            irregular += u32::from(st == PointStatus::Irregular);
+            non_finite += u32::from(st == PointStatus::NonFinite);
+        }
     }
     (capped, irregular, non_finite)
 }
