@@ -372,10 +372,13 @@ impl<const N: usize> Assembler<N> {
     #[inline(always)]
     fn vote_on(&mut self, xa: f32, za: f32, x: f32, z: f32) {
         let c = xa * z - za * x;
+        // Usually saturated in the stream's sense: then one compare and no store.
         if c > 0.0 {
-            self.vote = (self.vote + 1).min(VOTE_CLAMP);
-        } else if c < 0.0 {
-            self.vote = (self.vote - 1).max(-VOTE_CLAMP);
+            if self.vote < VOTE_CLAMP {
+                self.vote += 1;
+            }
+        } else if c < 0.0 && self.vote > -VOTE_CLAMP {
+            self.vote -= 1;
         }
     }
 
