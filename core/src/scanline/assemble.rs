@@ -349,7 +349,10 @@ impl<const N: usize> Assembler<N> {
             if let (Some(lt), Some((xa, za)), Some((xs, _))) =
                 (self.last_t, self.last_pt, self.last_side_pt)
             {
-                if lt.abs_diff(t_ns) <= self.params.gap_ns && (x > 0.0) == (xs > 0.0) {
+                // Time runs forward here (a step back, however small, takes the general
+                // path): one subtraction instead of an absolute difference.
+                let forward = t_ns >= lt && t_ns - lt <= self.params.gap_ns;
+                if forward && (x > 0.0) == (xs > 0.0) {
                     self.vote_on(xa, za, x, z);
                     self.last_pt = Some((x, z));
                     if x != 0.0 {
