@@ -228,6 +228,27 @@ mod tests {
         );
     }
 
+    /// The CRC over the two halves of a ring equals every form of the CRC over the joined
+    /// bytes, for every split point and every end.
+    #[test]
+    fn crc_two_at_every_split() {
+        let mut r = 7u32;
+        let mut buf = [0u8; 97];
+        for v in buf.iter_mut() {
+            r = r.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            *v = (r >> 24) as u8;
+        }
+        for cut in 0..=buf.len() {
+            let (a, b) = buf.split_at(cut);
+            for end in [0, 1, 3, 4, 5, 17, 52, 96, 97] {
+                let want = super::super::crc::crc32_bytewise(&buf[..end]);
+                assert_eq!(crc_two(a, b, end), want, "cut {cut} end {end}");
+                assert_eq!(super::super::crc::crc32_slice4(&buf[..end]), want);
+                assert_eq!(super::super::crc::crc32_slice8(&buf[..end]), want);
+            }
+        }
+    }
+
     #[test]
     fn packet_found_in_every_split_of_two_slices() {
         let mut enc = StreamEncoder::new();
