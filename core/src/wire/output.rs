@@ -642,22 +642,23 @@ fn fast_run<S: Copy>(
     ) else {
         return start;
     };
-    let mut k = start;
-    while let (Some(rec), Some(&t), Some(&xv), Some(&zv), Some(&rv), Some(&sv)) = (
-        recs.get_mut(k),
-        tag.get(k),
-        x.get(k),
-        z.get(k),
-        rho.get(k),
-        st.get(k),
-    ) {
+    for k in start..n {
+        let (Some(rec), Some(&t), Some(&xv), Some(&zv), Some(&rv), Some(&sv)) = (
+            recs.get_mut(k),
+            tag.get(k),
+            x.get(k),
+            z.get(k),
+            rho.get(k),
+            st.get(k),
+        ) else {
+            return k;
+        };
         let Some(words) = wire_status(sv).and_then(|b| fast_words(t, xv, zv, rv, b)) else {
             return k;
         };
         put_words(rec, words);
-        k += 1;
     }
-    k
+    n
 }
 
 /// Point `i` from `point(i)` as record words (the general path of
