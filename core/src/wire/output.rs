@@ -308,20 +308,22 @@ fn round_twice(s2: f32) -> i32 {
 /// The record words of a point taken straight from the kernel's f32 values — the same
 /// words as [`OutputPointRepr::from_f32`] followed by [`OutputPointRepr::emit`] (tested
 /// bit for bit) — or `None` when the point needs that general path: |x′| or |z′| ≥ 1024 m,
-/// |ρ| > 180°, or anything non-finite. |ρ| ≤ 180° bounds ρ·100 to ±18 000 after rounding,
-/// so the centidegree range needs no test of its own; −180.00 becomes +180.00 as there.
+/// ρ outside (−179.99°, 180°], or anything non-finite. In that range ρ·200 lies in
+/// (−35 998, 36 000], so ρ rounds to −17 999..=18 000 centidegrees: no range test and no
+/// −180.00 → +180.00 remapping of its own (ρ near −180° takes the general path, which
+/// does both).
 #[inline(always)]
 fn fast_words(tag: u32, x_m: f32, z_m: f32, rho_deg: f32, status: u8) -> Option<[u32; 4]> {
     let x_um = fast_um(x_m)?;
     let z_um = fast_um(z_m)?;
-    // In the FPU (vabs, vcmp against a constant register; false for NaN): as a bit test
-    // its integer constant cost the loop a register (measured: 2 instructions per point).
-    let in_range = rho_deg.abs() <= 180.0;
+    // Two FPU compares against constant registers; false for NaN. (|ρ| ≤ 180° as one bit
+    // test kept an integer constant in a register and needed the remapping: 4 instructions
+    // per point more, measured.)
+    let in_range = rho_deg > -179.99 && rho_deg <= 180.0;
     if !in_range {
         return None;
     }
     let rho = round_twice(rho_deg * 200.0);
-    let rho = if rho == -18_000 { 18_000 } else { rho };
     // |rho| ≤ 18 000: the cast keeps the value.
     let rho_cdeg = rho as i16;
     Some([
@@ -962,6 +964,11 @@ mod tests {
             (0.0f32, 0.0f32, -180.0f32),
             (0.0, 0.0, 180.0),
             (0.0, 0.0, -179.997), // rounds to −18 000 → +18 000
+            (0.0, 0.0, -179.99),  // the fast path's lower edge and its neighbours
+            (0.0, 0.0, f32::from_bits((-179.99f32).to_bits() - 1)),
+            (0.0, 0.0, f32::from_bits((-179.99f32).to_bits() + 1)),
+            (0.0, 0.0, -179.995), // −17 999.5 centidegrees → −18 000 → +18 000
+            (0.0, 0.0, f32::from_bits(180f32.to_bits() - 1)),
             (0.0, 0.0, f32::from_bits(180f32.to_bits() + 1)),
             (f32::from_bits(1024f32.to_bits() - 1), -1023.9999, 0.0),
             (1024.0, 0.0, 0.0),
