@@ -36,7 +36,10 @@
 
 use crate::kernel::{Kernel, KernelParams, ParamsError, PointStatus, ScanlineOutput};
 use crate::scanline::{Ingest, IngestCounters, IngestEvent};
-use crate::wire::{EncodeError, OutputHeaderRepr, OutputPointRepr, StreamEncoder};
+use crate::wire::{
+    EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr, StreamEncoder,
+    MAX_OUTPUT_POINTS_PER_PACKET,
+};
 
 /// Everything the pipeline counted: ingest's counters plus the kernel's, summed over lines,
 /// and the config packets.
@@ -202,16 +205,59 @@ impl<const RING: usize, const N: usize> Default for Pipeline<RING, N> {
 /// `docs/wire-format.md`); returns the bytes written. `buf` needs
 /// `wire::output_packet_len` of each fragment — at most
 /// ⌈len / `MAX_OUTPUT_POINTS_PER_PACKET`⌉ · `MAX_PACKET_LEN` bytes. The header is
-/// [`output_header`]'s and point `i` is [`output_point`]'s (a sender short of RAM writes one
-/// packet at a time with them and `StreamEncoder::encode_output_fragment`, as the firmware
-/// does: the same bytes).
+/// [`output_header`]'s and point `i` is [`output_point`]'s; each packet is
+/// [`encode_output_fragment`]'s (a sender short of RAM writes one packet at a time with
+/// it, as the firmware does: the same bytes). On an error, packets already written stay
+/// written (and have used their sequence numbers).
 pub fn encode_output(
     out: &ScanlineOutput<'_>,
     enc: &mut StreamEncoder,
     buf: &mut [u8],
 ) -> Result<usize, EncodeError> {
     let header = output_header(out)?;
-    enc.encode_output_line(&header, |i| output_point(out, i), buf)
+    let mut at = 0usize;
+    for k in 0..header.fragments() {
+        let first = k
+            .checked_mul(MAX_OUTPUT_POINTS_PER_PACKET)
+            .and_then(|f| u16::try_from(f).ok())
+            .ok_or(EncodeError::OutOfRange { index: k })?;
+        let dst = buf.get_mut(at..).unwrap_or(&mut []);
+        at += encode_output_fragment(out, &header, first, enc, dst)?;
+    }
+    Ok(at)
+}
+
+/// Writes the output packet of a line whose points start at `first` (0, then steps of
+/// `MAX_OUTPUT_POINTS_PER_PACKET`), `header` being [`output_header`]'s; returns its
+/// length. The bytes are those of `StreamEncoder::encode_output_fragment` with
+/// [`output_point`], written by the encoder's tight loop over the line's columns
+/// (`StreamEncoder::encode_output_columns`): points it cannot take directly (status
+/// [`PointStatus::NonFinite`], non-finite or large values) go through [`output_point`],
+/// errors included.
+pub fn encode_output_fragment(
+    out: &ScanlineOutput<'_>,
+    header: &OutputHeaderRepr,
+    first: u16,
+    enc: &mut StreamEncoder,
+    buf: &mut [u8],
+) -> Result<usize, EncodeError> {
+    let cols = OutputColumns {
+        tag: out.tag,
+        x_m: out.x_m,
+        z_m: out.z_m,
+        rho_deg: out.rho_deg,
+        status: out.status,
+    };
+    // NonFinite points are sent at x′ = z′ = 0 by `output_point`: not the fast path's.
+    let wire_status = |s: PointStatus| (s != PointStatus::NonFinite).then_some(s as u8);
+    enc.encode_output_columns(
+        header,
+        first,
+        &cols,
+        wire_status,
+        |i| output_point(out, i),
+        buf,
+    )
 }
 
 /// The wire header of a line's output packets. Counters above 65 535 saturate in the
@@ -393,6 +439,59 @@ mod tests {
             Some(ParamsError::OutOfRange { index: 0 })
         );
         assert_eq!(p.params().d_b_m, 0.05);
+    }
+
+    /// `encode_output` (the columns encoder) writes the bytes of the general encoder with
+    /// `output_point`, also for a line with a NonFinite point, a non-finite ρ and values
+    /// beyond the fast path.
+    #[test]
+    fn encode_output_is_the_general_encoder() {
+        let mut enc = StreamEncoder::new();
+        let mut bytes = Vec::new();
+        stream(&mut enc, 1, &mut bytes);
+        let mut p = std::boxed::Box::new(Pipeline::<RING, N>::new());
+        p.write(&bytes);
+        let mut checked = 0;
+        p.finish(|o| {
+            let mut x = o.x_m.to_vec();
+            let mut rho = o.rho_deg.to_vec();
+            let mut status = o.status.to_vec();
+            status[5] = PointStatus::NonFinite;
+            x[5] = f32::NAN;
+            x[7] = 1500.0; // beyond the fast path's 1024 m, within the format's 2147 m
+            rho[9] = -180.0;
+            let o = ScanlineOutput {
+                x_m: &x,
+                rho_deg: &rho,
+                status: &status,
+                ..*o
+            };
+            let mut fast = std::vec![0u8; 8 * MAX_PACKET_LEN];
+            let mut general = std::vec![0u8; 8 * MAX_PACKET_LEN];
+            let n = encode_output(&o, &mut StreamEncoder::with_seq(9), &mut fast).unwrap();
+            let h = output_header(&o).unwrap();
+            let m = StreamEncoder::with_seq(9)
+                .encode_output_line(&h, |i| output_point(&o, i), &mut general)
+                .unwrap();
+            assert_eq!(fast[..n], general[..m]);
+            // A NaN ρ is an error with its index on both paths.
+            let mut rho2 = rho.clone();
+            rho2[11] = f32::NAN;
+            let o = ScanlineOutput {
+                rho_deg: &rho2,
+                ..o
+            };
+            assert_eq!(
+                encode_output(&o, &mut StreamEncoder::new(), &mut fast),
+                Err(EncodeError::NonFinite { index: 11 })
+            );
+            assert_eq!(
+                StreamEncoder::new().encode_output_line(&h, |i| output_point(&o, i), &mut general),
+                Err(EncodeError::NonFinite { index: 11 })
+            );
+            checked += 1;
+        });
+        assert_eq!(checked, 1);
     }
 
     #[test]

@@ -6,8 +6,8 @@
 //! The links are `embedded_io::{Read, Write}` (embedded-hal 1.0 has no serial traits), so
 //! a UART, SPI or DMA driver replaces the semihosting files of the QEMU build without this
 //! loop changing. Everything between the links is the core's: `Pipeline::run` (ingest,
-//! config packets, kernel) and `pipeline::{output_header, output_point}` (the bytes
-//! `encode_output` writes), so `firmware/check.sh` compares the same code on two CPUs.
+//! config packets, kernel) and `pipeline::{output_header, encode_output_fragment}` (the
+//! bytes `encode_output` writes), so `firmware/check.sh` compares the same code on two CPUs.
 
 use curbtrace_core::kernel::{KernelCounters, ScanlineOutput};
 use curbtrace_core::pipeline::{self, Pipeline, PipelineCounters};
@@ -152,8 +152,7 @@ fn emit_line<W: Write, E>(
     for k in 0..header.fragments() {
         let first = u16::try_from(k * MAX_OUTPUT_POINTS_PER_PACKET)
             .map_err(|_| Error::Encode(out.index, EncodeError::OutOfRange { index: k }))?;
-        let n = enc
-            .encode_output_fragment(&header, first, |i| pipeline::output_point(out, i), packet)
+        let n = pipeline::encode_output_fragment(out, &header, first, enc, packet)
             .map_err(|e| Error::Encode(out.index, e))?;
         output.write_all(&packet[..n]).map_err(Error::Write)?;
         sum.packets_out += 1;

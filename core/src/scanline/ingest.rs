@@ -292,12 +292,12 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
                 let at = HEADER_LEN + POINTS_PREFIX_LEN + cur.next * POINT_RECORD_LEN;
                 // Parse in place when the record is contiguous; copy it out only when it
                 // straddles the ring's seam. The scanner checked the packet is all there.
-                let parsed = match a.get(at..at + POINT_RECORD_LEN) {
-                    Some(rec) => PointRecord::parse(rec),
+                let parsed = match a.get(at..).and_then(|r| r.first_chunk()) {
+                    Some(rec) => PointRecord::parse_array(rec),
                     None => {
                         let mut rec = [0u8; POINT_RECORD_LEN];
                         let _ = crate::wire::copy_from_two(a, b, at, &mut rec);
-                        PointRecord::parse(&rec)
+                        PointRecord::parse_array(&rec)
                     }
                 };
                 let p = match parsed {

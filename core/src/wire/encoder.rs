@@ -1,10 +1,10 @@
 //! [`StreamEncoder`]: writes whole packets and keeps the sequence numbers (no_std, no alloc).
 
-use super::output::emit_output_fragment;
+use super::output::{emit_output_fragment, emit_output_fragment_columns};
 use super::points::emit_points;
 use super::{
-    ConfigRepr, EncodeError, OutputHeaderRepr, OutputPointRepr, PointRecord, CONFIG_WORDS,
-    MAX_OUTPUT_POINTS_PER_PACKET,
+    ConfigRepr, EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr, PointRecord,
+    CONFIG_WORDS, MAX_OUTPUT_POINTS_PER_PACKET,
 };
 
 /// Encodes packets of one stream. Every successfully written packet takes the next sequence
@@ -103,6 +103,34 @@ impl StreamEncoder {
         out: &mut [u8],
     ) -> Result<usize, EncodeError> {
         let r = emit_output_fragment(self.seq, header, first, &mut point, out);
+        self.bump(r)
+    }
+
+    /// [`Self::encode_output_fragment`] for a line held as columns (the kernel's structure
+    /// of arrays): point `i` is built from `cols` in a tight loop that builds each record
+    /// in registers and stores it as four words. Points it does not take —
+    /// `wire_status(cols.status[i])` is `None`, a value is non-finite or large (|x′|, |z′|
+    /// ≥ 1024 m, |ρ| > 180°), or a column is too short — come from `point(i)`, exactly as
+    /// [`Self::encode_output_fragment`] would take them, with the same errors. For the same
+    /// points the bytes are identical.
+    pub fn encode_output_columns<S: Copy>(
+        &mut self,
+        header: &OutputHeaderRepr,
+        first: u16,
+        cols: &OutputColumns<'_, S>,
+        wire_status: impl Fn(S) -> Option<u8>,
+        mut point: impl FnMut(usize) -> Result<OutputPointRepr, EncodeError>,
+        out: &mut [u8],
+    ) -> Result<usize, EncodeError> {
+        let r = emit_output_fragment_columns(
+            self.seq,
+            header,
+            first,
+            cols,
+            wire_status,
+            &mut point,
+            out,
+        );
         self.bump(r)
     }
 

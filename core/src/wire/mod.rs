@@ -51,7 +51,8 @@ mod scan;
 pub use crate::kernel::CONFIG_WORDS;
 pub use encoder::StreamEncoder;
 pub use output::{
-    OutputHeaderRepr, OutputPointRepr, OutputPoints, OUTPUT_HEADER_LEN, OUTPUT_POINT_LEN,
+    OutputColumns, OutputHeaderRepr, OutputPointRepr, OutputPoints, OUTPUT_HEADER_LEN,
+    OUTPUT_POINT_LEN,
 };
 pub use points::{PointRecord, PointsRepr, POINT_FLAG_LINE_START, POINT_RECORD_LEN};
 pub(crate) use scan::copy_from_two;

@@ -86,6 +86,10 @@ pub(crate) fn copy_from_two(a: &[u8], b: &[u8], start: usize, dst: &mut [u8]) ->
 }
 
 /// CRC-32 of bytes `0..end` of `a ++ b` (caller guarantees `end ≤ a.len() + b.len()`).
+/// Out of line: inlined into the ingest loop, the CRC's table bases and the loop's own
+/// registers competed and both spilled (measured on the M4F: +14 instructions per point
+/// for the CRC, +32 for the rest of ingest).
+#[inline(never)]
 fn crc_two(a: &[u8], b: &[u8], end: usize) -> u32 {
     let mut c = Crc32::new();
     c.update(a.get(..end.min(a.len())).unwrap_or(&[]));
@@ -226,6 +230,27 @@ mod tests {
                 reason: GarbageReason::NoSync
             }
         );
+    }
+
+    /// The CRC over the two halves of a ring equals every form of the CRC over the joined
+    /// bytes, for every split point and every end.
+    #[test]
+    fn crc_two_at_every_split() {
+        let mut r = 7u32;
+        let mut buf = [0u8; 97];
+        for v in buf.iter_mut() {
+            r = r.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            *v = (r >> 24) as u8;
+        }
+        for cut in 0..=buf.len() {
+            let (a, b) = buf.split_at(cut);
+            for end in [0, 1, 3, 4, 5, 17, 52, 96, 97] {
+                let want = super::super::crc::crc32_bytewise(&buf[..end]);
+                assert_eq!(crc_two(a, b, end), want, "cut {cut} end {end}");
+                assert_eq!(super::super::crc::crc32_slice4(&buf[..end]), want);
+                assert_eq!(super::super::crc::crc32_slice8(&buf[..end]), want);
+            }
+        }
     }
 
     #[test]
