@@ -174,14 +174,18 @@ enum Step {
 }
 
 /// Ring of `RING` bytes + parser + assembler of lines of up to `N` points.
+// `repr(C)`, the small state first, then the assembler (its per-point state leads it),
+// the ring's bytes last: the per-point path reaches every field it touches with an
+// immediate offset on the Cortex-M4F instead of building each offset first.
+#[repr(C)]
 pub struct Ingest<const RING: usize, const N: usize> {
-    ring: Ring<RING>,
-    asm: Assembler<N>,
     cur: Option<Current>,
-    pending_config: Option<[u32; CONFIG_WORDS]>,
     next_seq: Option<u32>,
     finishing: bool,
+    pending_config: Option<[u32; CONFIG_WORDS]>,
     c: IngestCounters,
+    asm: Assembler<N>,
+    ring: Ring<RING>,
 }
 
 impl<const RING: usize, const N: usize> Ingest<RING, N> {

@@ -9,14 +9,15 @@
 
 /// A byte ring of capacity `CAP`.
 #[derive(Clone)]
+#[repr(C)] // the indices first, the bytes last (immediate offsets on the M4F)
 pub struct Ring<const CAP: usize> {
-    buf: [u8; CAP],
     /// Index of the oldest unread byte (`< CAP`, or 0 when `CAP` is 0).
     head: usize,
     /// Unread bytes (`≤ CAP`).
     len: usize,
     /// Bytes refused by [`Ring::write`] / [`Ring::commit`] because the ring was full.
     dropped: u64,
+    buf: [u8; CAP],
 }
 
 impl<const CAP: usize> Ring<CAP> {
