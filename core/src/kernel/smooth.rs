@@ -35,6 +35,8 @@
 //!   so a point costs one load, one store and three float operations per step (and one
 //!   multiplication per block) instead of a load, a store and loop overhead per step.
 
+use crate::math;
+
 /// Steps per block (see the module docs); even, so every block starts with λ. The fused
 /// wavefront of a full block keeps 3 values of each of its 8 steps and 8 factors r_s in
 /// registers: 32, all of the M4F's single-precision registers.
@@ -73,10 +75,40 @@ impl Block {
         b
     }
 
+    /// Whether the scaled form is safe for these λ, μ: every G_s of a block at least
+    /// [`MIN_SCALE`] in magnitude. Then the scaled values, and r_s times them, stay below
+    /// about 4·10³⁵ for coordinates the kernel keeps (≤ 2000 m, grown at most 3× per μ
+    /// step within a block: 81×), inside f32's 3.4·10³⁸. With |λ·μ| below about 4·10⁻⁸
+    /// (valid in a config packet, useless as smoothing) G would underflow and 1/G
+    /// overflow; [`taubin_smooth`] then takes the plain form, on every target alike.
+    fn scaled_ok(&self) -> bool {
+        self.g.iter().all(|g| math::abs(*g) >= MIN_SCALE) && self.r.iter().all(|r| r.is_finite())
+    }
+
     /// r_s of step `s`.
     #[inline(always)]
     fn r(&self, s: usize) -> f32 {
         self.r[s % 2]
+    }
+}
+
+/// Smallest |G_s| the scaled form accepts (2⁻¹⁰⁰ ≈ 7.9·10⁻³¹, a normal f32; see
+/// [`Block::scaled_ok`]).
+const MIN_SCALE: f32 = 1.0 / (1u128 << 100) as f32;
+
+/// Eq. 3 as written, p ← p + a·(½(p₋ + p₊) − p), one step in place with the ends fixed:
+/// the form for parameters outside the scaled form's range ([`Block::scaled_ok`]).
+fn plain_step_in_place(v: &mut [f32], a: f32) {
+    let n = v.len();
+    if n < 3 {
+        return;
+    }
+    let (mut l, mut c) = (v[0], v[1]);
+    for i in 1..n - 1 {
+        let r = v[i + 1];
+        v[i] = c + a * (0.5 * (l + r) - c);
+        l = c;
+        c = r;
     }
 }
 
@@ -322,6 +354,7 @@ pub(crate) fn taubin_smooth(
     let gap2 = gap_m * gap_m;
     let split = gap_m > 0.0;
     let b = Block::new(lambda, mu);
+    let scaled = b.scaled_ok();
     let mut pieces = 0;
     let mut start = 0;
     while start < n {
@@ -340,8 +373,16 @@ pub(crate) fn taubin_smooth(
         } else {
             n
         };
-        smooth_piece(&mut x[start..end], scratch, steps, &b);
-        smooth_piece(&mut z[start..end], scratch, steps, &b);
+        if scaled {
+            smooth_piece(&mut x[start..end], scratch, steps, &b);
+            smooth_piece(&mut z[start..end], scratch, steps, &b);
+        } else {
+            for v in [&mut x[start..end], &mut z[start..end]] {
+                for k in 0..steps {
+                    plain_step_in_place(v, if k % 2 == 0 { lambda } else { mu });
+                }
+            }
+        }
         pieces += 1;
         start = end;
     }
@@ -434,6 +475,49 @@ mod tests {
                     assert_eq!(a[i].to_bits(), f[i].to_bits(), "n {n} steps {steps} i {i}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn parameters_near_zero_take_the_plain_form_and_stay_finite() {
+        // λ = 10⁻²⁰ underflows G (and 1/G overflows): the scaled form would give inf.
+        for (lambda, mu, steps) in [(1e-20f32, -1e-20f32, 20u32), (1e-9, -1e-9, 200)] {
+            assert!(!Block::new(lambda, mu).scaled_ok(), "{lambda} {mu}");
+            let n = 40;
+            let v = noisy(n, 3);
+            let want = reference(&v[..n], steps, f64::from(lambda), f64::from(mu));
+            let mut x = [0.0f32; 64];
+            let mut z = [0.0f32; 64];
+            for i in 0..n {
+                x[i] = v[i] as f32;
+                z[i] = 2.0 * v[i] as f32;
+            }
+            let mut scratch = [0.0f32; 64];
+            taubin_smooth(
+                &mut x[..n],
+                &mut z[..n],
+                &mut scratch,
+                0.0,
+                steps,
+                lambda,
+                mu,
+            );
+            for i in 0..n {
+                assert!(x[i].is_finite() && z[i].is_finite(), "{lambda} {mu} i {i}");
+                assert!(
+                    (f64::from(x[i]) - want[i]).abs() < 1e-4,
+                    "{lambda} {mu} i {i}"
+                );
+            }
+        }
+        // The defaults and the ends of the documented ranges stay on the scaled form.
+        for (lambda, mu) in [
+            (0.6307f32, -0.6732f32),
+            (1.0, -1.0),
+            (1e-3, -1e-3),
+            (1.0, -1e-6),
+        ] {
+            assert!(Block::new(lambda, mu).scaled_ok(), "{lambda} {mu}");
         }
     }
 
