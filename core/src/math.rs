@@ -60,10 +60,11 @@ impl Backend for Libm {
 /// max(|y|, |x|) ∈ [0, 1], a = atan q, then a, π/2 − a, π − a by octant and the sign of y.
 ///
 /// The textbook reduction, and cheaper than `libm::atan2f` on the kernel's arguments
-/// (finite, not both zero — the bend angle returns 0 before asking for those): atan2f's
-/// special-case tests for NaN, infinities, zeros and extreme ratios go, and atanf always
-/// gets an argument ≤ 1, its short path (no reciprocal). On the Cortex-M4F it saved about
-/// 20 instructions per kept point (docs/benchmarks.md). Every step is an IEEE-754 f32
+/// (finite: the kernel sets non-finite and out-of-range points aside first): atan2f's
+/// special-case tests for NaN, infinities, zeros and extreme ratios go (x = y = 0 is one
+/// test here, and gives +0, which the bend angle relies on), and atanf always gets an
+/// argument ≤ 1, its short path (no reciprocal). On the Cortex-M4F it saved 13
+/// instructions per input point (docs/benchmarks.md). Every step is an IEEE-754 f32
 /// operation or `libm::atanf`, so the host and the M4F agree bit for bit. Accuracy: atanf's
 /// 1 ulp plus one rounded subtraction — within 2 ulp of the true angle (tested against f64
 /// over every octant). At y = ±0 it gives +0 or π (atan2f: ±0 or ±π); x = y = 0 gives 0.
