@@ -18,9 +18,10 @@
 //! and the true values come back as p = G·u. The steps are taken in *blocks* of
 //! [`BLOCK`] steps (the last block shorter): each block starts from true values (u₀ = p,
 //! G₀ = 1) and ends with one multiplication by G of its length, so the scale stays within
-//! a factor of about 10⁴ however many steps there are (200 unscaled steps would overflow
-//! f32). A fixed end keeps its true value p_e, so in step s of a block its scaled value is
-//! p_e·(1/G_s). The scaled form rounds differently from Eq. 3 as written, by a few ulp
+//! a factor of about 10⁴ for the default λ, μ however many steps there are (200 unscaled
+//! steps would overflow f32). λ, μ so near zero that G would underflow take Eq. 3 as
+//! written instead, on every target alike (`Block::scaled_ok`). A fixed end keeps its true
+//! value p_e, so in step s of a block its scaled value is p_e·(1/G_s). The scaled form rounds differently from Eq. 3 as written, by a few ulp
 //! (tested against an f64 reference); every value is computed by this one expression from
 //! the previous step's three values, so the two evaluation orders below give the same bits
 //! (tested), and the host and the Cortex-M4F agree bit for bit whichever they use:
