@@ -81,20 +81,7 @@ fn windows_sweeps(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8], t_off: &mut [
     // Backward: t(j) is the last index ≤ min(t(j + 1), j + MAX_SIDE) within d_b; j ≤ t < n.
     let mut t = n.saturating_sub(1);
     for j in (0..n).rev() {
-        let (xj, zj) = (x[j], z[j]);
-        let far = |k: usize| {
-            let (dx, dz) = (x[k] - xj, z[k] - zj);
-            !(dx * dx + dz * dz <= d2)
-        };
-        // j ≤ t: min(t, j + MAX_SIDE) as a comparison of the offset.
-        if t - j > MAX_SIDE {
-            let (cap, stopped) = back_cap(x, z, d2, j);
-            t = cap;
-            capped += stopped;
-        }
-        while t > j && far(t) {
-            t -= 1;
-        }
+        back_walk(x, z, d2, j, &mut t, &mut capped);
         t_off[j] = (t - j) as u8;
     }
     capped
@@ -151,6 +138,35 @@ fn fwd_capped(x: &[f32], z: &[f32], d2: f32, s: usize, i: usize) -> u32 {
     }
     let (dx, dz) = (x[s - 1] - x[i], z[s - 1] - z[i]);
     u32::from(dx * dx + dz * dz <= d2)
+}
+
+/// One step of the backward sweep: moves `t` from t(j + 1) down to t(j) (capped at
+/// j + [`MAX_SIDE`], counted in `capped`) and returns p_t − p_j from the walk's last
+/// distance test — b of the §2.4 test and of ρ, the same bits they would compute; (0, 0)
+/// when t = j, as x_j − x_j.
+#[inline(always)]
+fn back_walk(
+    x: &[f32],
+    z: &[f32],
+    d2: f32,
+    j: usize,
+    t: &mut usize,
+    capped: &mut u32,
+) -> (f32, f32) {
+    let (xj, zj) = (x[j], z[j]);
+    if *t - j > MAX_SIDE {
+        let (cap, stopped) = back_cap(x, z, d2, j);
+        *t = cap;
+        *capped += stopped;
+    }
+    while *t > j {
+        let (dx, dz) = (x[*t] - xj, z[*t] - zj);
+        if dx * dx + dz * dz <= d2 {
+            return (dx, dz);
+        }
+        *t -= 1;
+    }
+    (0.0, 0.0)
 }
 
 /// The backward window's cap at point `j`, out of line (rare: runs of returns on one
@@ -405,23 +421,7 @@ fn windows_sweeps_marked(
     let (mut irregular, mut non_finite) = (0u32, 0u32);
     let mut t = n.saturating_sub(1);
     for j in (0..n).rev() {
-        let (xj, zj) = (x[j], z[j]);
-        if t - j > MAX_SIDE {
-            let (cap, stopped) = back_cap(x, z, d2, j);
-            t = cap;
-            capped += stopped;
-        }
-        // The walk, keeping p_t − p_j from its last distance test: the judgement's b,
-        // the same bits it would compute ((0, 0) when t = j, as x_j − x_j).
-        let (mut bx, mut bz) = (0.0f32, 0.0f32);
-        while t > j {
-            let (dx, dz) = (x[t] - xj, z[t] - zj);
-            if dx * dx + dz * dz <= d2 {
-                (bx, bz) = (dx, dz);
-                break;
-            }
-            t -= 1;
-        }
+        let (bx, bz) = back_walk(x, z, d2, j, &mut t, &mut capped);
         t_off[j] = (t - j) as u8;
         let st = judge_b(x, z, j, usize::from(s_off[j]), t - j, (bx, bz), thr);
         status[j] = st;
@@ -472,22 +472,7 @@ fn windows_sweeps_angles<M: Backend>(
     let mut capped = forward_sweep(x, z, d2, s_off);
     let mut t = n.saturating_sub(1);
     for j in (0..n).rev() {
-        let (xj, zj) = (x[j], z[j]);
-        if t - j > MAX_SIDE {
-            let (cap, stopped) = back_cap(x, z, d2, j);
-            t = cap;
-            capped += stopped;
-        }
-        // The walk, keeping p_t − p_j from its last distance test (ρ's b, same bits).
-        let (mut bx, mut bz) = (0.0f32, 0.0f32);
-        while t > j {
-            let (dx, dz) = (x[t] - xj, z[t] - zj);
-            if dx * dx + dz * dz <= d2 {
-                (bx, bz) = (dx, dz);
-                break;
-            }
-            t -= 1;
-        }
+        let (bx, bz) = back_walk(x, z, d2, j, &mut t, &mut capped);
         t_off[j] = (t - j) as u8;
         let s = j - usize::from(s_off[j]);
         rho[j] = if s == j || t == j {
