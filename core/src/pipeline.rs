@@ -36,10 +36,7 @@
 
 use crate::kernel::{Kernel, KernelParams, ParamsError, PointStatus, ScanlineOutput};
 use crate::scanline::{Ingest, IngestCounters, IngestEvent};
-use crate::wire::{
-    EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr, StreamEncoder,
-    MAX_OUTPUT_POINTS_PER_PACKET,
-};
+use crate::wire::{EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr, StreamEncoder};
 
 /// Everything the pipeline counted: ingest's counters plus the kernel's, summed over lines,
 /// and the config packets.
@@ -217,10 +214,7 @@ pub fn encode_output(
     let header = output_header(out)?;
     let mut at = 0usize;
     for k in 0..header.fragments() {
-        let first = k
-            .checked_mul(MAX_OUTPUT_POINTS_PER_PACKET)
-            .and_then(|f| u16::try_from(f).ok())
-            .ok_or(EncodeError::OutOfRange { index: k })?;
+        let first = OutputHeaderRepr::fragment_first(k)?;
         let dst = buf.get_mut(at..).unwrap_or(&mut []);
         at += encode_output_fragment(out, &header, first, enc, dst)?;
     }

@@ -146,10 +146,7 @@ impl StreamEncoder {
     ) -> Result<usize, EncodeError> {
         let mut at = 0usize;
         for k in 0..header.fragments() {
-            let first = k
-                .checked_mul(MAX_OUTPUT_POINTS_PER_PACKET)
-                .and_then(|f| u16::try_from(f).ok())
-                .ok_or(EncodeError::OutOfRange { index: k })?;
+            let first = OutputHeaderRepr::fragment_first(k)?;
             let dst = out.get_mut(at..).unwrap_or(&mut []);
             let n = self.encode_output_fragment(header, first, &mut point, dst)?;
             at += n;

@@ -60,6 +60,13 @@ impl OutputHeaderRepr {
             .max(1)
     }
 
+    /// The first point of fragment `k` (`k < fragments()`), as the packet carries it.
+    pub(crate) fn fragment_first(k: usize) -> Result<u16, EncodeError> {
+        k.checked_mul(MAX_OUTPUT_POINTS_PER_PACKET)
+            .and_then(|f| u16::try_from(f).ok())
+            .ok_or(EncodeError::OutOfRange { index: k })
+    }
+
     /// Checks the index fields against `line_len`.
     fn indices_ok(&self) -> bool {
         [self.nadir, self.left, self.right]
