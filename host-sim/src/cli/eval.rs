@@ -1,4 +1,4 @@
-//! `curbtrace eval`: scores extracted edges against reference lines (SPEC §5) and prints the
+//! `curbtrace eval`: scores extracted edges against reference lines (docs/spec.md §5) and prints the
 //! table of Honma et al.'s Tables 2 and 3; `--json OUT` writes the same numbers as JSON.
 
 use anyhow::Context;

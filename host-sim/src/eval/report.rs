@@ -1,4 +1,4 @@
-//! The demo's outputs after extraction (issue 5): evaluate, draw the pictures and write
+//! The demo's outputs after extraction: evaluate, draw the pictures and write
 //! `report.md` (metrics table, links to the pictures, the parameters, timings) and
 //! `eval.json`.
 //!

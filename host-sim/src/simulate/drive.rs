@@ -6,7 +6,7 @@
 //! scanner height along the body's up axis.
 
 use super::scanner::body_axes;
-use super::scene::World;
+use super::world::World;
 use crate::io::trajectory::{Pose, Trajectory};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -1,10 +1,13 @@
-//! The scene simulator behind `curbtrace simulate` (SPEC §4): a physically modelled mobile
+//! The scene simulator behind `curbtrace simulate` (docs/spec.md §4): a physically modelled mobile
 //! laser scanner driving through a street, writing `points.laz`, `trajectory.csv` and
 //! `reference.geojson`.
 //!
 //! | module | what |
 //! |---|---|
-//! | [`scene`] | scene descriptions in road coordinates; the built-in scenes; building the world |
+//! | [`centerline`] | the road centre line and road coordinates `(u, v)` |
+//! | [`scene`] | scene descriptions in road coordinates and the curb toe lines they imply |
+//! | [`scenes`] | the named scenes, one file each |
+//! | [`world`] | building the world: ground, walls, poles, parked cars, weeds, leaves |
 //! | [`ground`] | road, curbs (batter, rounded top), curb cuts, sidewalks as an exact height field |
 //! | [`prims`] | walls, fences, parked cars, poles, weeds, leaves, and the ray walk through them |
 //! | [`drive`] | the vehicle's path, speed and attitude → the 200 Hz trajectory |
@@ -36,15 +39,20 @@
 //! println!("{} points", summary.points);
 //! ```
 
+pub mod centerline;
 pub mod drive;
 pub mod ground;
 pub mod prims;
 pub mod reference;
 pub mod scanner;
 pub mod scene;
+pub mod scenes;
+pub mod world;
 pub mod write;
 
-pub use scene::{SceneSpec, World, SCENE_NAMES};
+pub use scene::SceneSpec;
+pub use scenes::SCENE_NAMES;
+pub use world::World;
 
 /// The brief's name for a scene description.
 pub type Scene = SceneSpec;

@@ -15,7 +15,7 @@
 //! A segment's category is its vertices' category, or the special one (curb cut,
 //! intersection, bus bay) when they differ. Intersection covers the corner arcs and the
 //! side street's curbs. The side is the sign of the segment midpoint's lateral offset x′
-//! from the nearest trajectory sample (SPEC §2: left positive).
+//! from the nearest trajectory sample (docs/spec.md §2: left positive).
 
 use super::ground::{Ground, ToeCoord};
 use crate::io::trajectory::Trajectory;

@@ -9,64 +9,24 @@
 //!
 //! Scan angle θ is measured in the scan plane from that lowest direction, positive towards
 //! `a × down` (or the other way with `counter_clockwise = false`), in (−180°, 180°]. A line
-//! starts at the top (θ = −180°) and ends at the top, so lines split at the top as SPEC §2
+//! starts at the top (θ = −180°) and ends at the top, so lines split at the top as docs/spec.md §2
 //! expects. Pulse `j` of line `k` fires at `t = t0 + k/line_rate + j/(line_rate·pulses)`
 //! with θ = −180° + 360°·(j + ½)/pulses; every pulse uses the pose interpolated at its own
 //! time, so the vehicle moves during a line.
 //!
-//! Body rotation (SPEC §2 heading; roll and pitch as in aviation): start from
+//! Body rotation (docs/spec.md §2 heading; roll and pitch as in aviation): start from
 //! forward `f = (sin h, cos h, 0)`, left `l = (−cos h, sin h, 0)`, up `u`; pitch (nose up
 //! positive) turns `f` and `u` about `l`; roll (right side down positive) then turns `l` and
 //! `u` about the new forward axis.
 
 use super::ground::ToeCoord;
 use super::prims::Material;
-use super::scene::World;
+use super::world::World;
 use crate::io::trajectory::{Pose, Trajectory};
 use rand::Rng;
 use rand_distr::StandardNormal;
 
-/// Scanner parameters.
-#[derive(Clone, Copy, Debug)]
-pub struct ScannerConfig {
-    /// Scan lines (mirror revolutions) per second.
-    pub line_rate_hz: f64,
-    /// Pulses per line.
-    pub pulses_per_line: usize,
-    /// Height of the scanner origin above the road, metres.
-    pub height_m: f64,
-    /// Yaw of the scan plane from the driving direction, degrees (to the left).
-    pub yaw_deg: f64,
-    /// Tilt of the scan plane from the vertical, degrees.
-    pub pitch_deg: f64,
-    /// Direction of rotation.
-    pub counter_clockwise: bool,
-    /// Range noise, one sigma, metres.
-    pub range_sigma_m: f64,
-    /// Fraction of returns that are outliers (range off by up to metres).
-    pub outlier_rate: f64,
-    /// Minimum range: nearer echoes are suppressed, metres.
-    pub min_range_m: f64,
-    /// Maximum range, metres.
-    pub max_range_m: f64,
-}
-
-impl Default for ScannerConfig {
-    fn default() -> Self {
-        ScannerConfig {
-            line_rate_hz: 100.0,
-            pulses_per_line: 2000,
-            height_m: 2.0,
-            yaw_deg: 45.0,
-            pitch_deg: 40.0,
-            counter_clockwise: true,
-            range_sigma_m: 0.005,
-            outlier_rate: 2e-4,
-            min_range_m: 1.5,
-            max_range_m: 120.0,
-        }
-    }
-}
+pub use super::scene::ScannerConfig;
 
 /// Body axes (forward, left, up) in world coordinates for a pose.
 pub fn body_axes(heading_deg: f64, pitch_deg: f64, roll_deg: f64) -> [[f64; 3]; 3] {

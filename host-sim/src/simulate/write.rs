@@ -1,5 +1,5 @@
 //! Writers: `points.laz` (LAS 1.4, point format 6, 1 mm scale, CRS offsets, WKT CRS VLR)
-//! and `trajectory.csv` (SPEC §3).
+//! and `trajectory.csv` (docs/spec.md §3).
 
 use super::scanner::Return;
 use super::SimError;
@@ -102,7 +102,7 @@ pub fn write_points(
     Ok(())
 }
 
-/// Writes `time,x,y,z,roll,pitch,heading` (SPEC §3), positions + `origin`.
+/// Writes `time,x,y,z,roll,pitch,heading` (docs/spec.md §3), positions + `origin`.
 pub fn write_trajectory(path: &Path, traj: &Trajectory, origin: [f64; 3]) -> Result<(), SimError> {
     let io = |source: std::io::Error| SimError::Io {
         path: path.display().to_string(),
