@@ -10,12 +10,14 @@
 //!
 //! | module | what |
 //! |---|---|
-//! | [`model`] | shared types: sides, categories, polylines, edges; GeoJSON in and out |
-//! | `io` | LAS/LAZ reading (columns), trajectory CSV, output writers |
-//! | `replay` | projection (step a), wire encoding, running the core in-process |
+//! | [`model`] | shared types: sides, categories, polylines, edges; reading GeoJSON lines |
+//! | `io` | LAS/LAZ reading (columns), trajectory CSV |
+//! | `replay` | projection (step a), wire encoding, running the core in-process; candidates and per-point status |
 //! | `bend` | seeding (§2.6), tracking (§2.7), post-filters |
+//! | `output` | sinks: GeoJSON and CSV writers of the edges |
+//! | `proc_stats` | CPU time and peak memory of this process, from `/proc` |
 //! | `qiu` | the second method (Qiu et al. 2016) |
-//! | `eval` | completeness, correctness, quality, RMS, gaps (SPEC §5) |
+//! | `eval` | completeness, correctness, quality, RMS, gaps (docs/spec.md §5) |
 //! | `simulate` | the scene simulator |
 //! | `plot` | pictures |
 
@@ -24,8 +26,10 @@ pub mod config;
 pub mod eval;
 pub mod io;
 pub mod model;
+pub mod output;
 pub mod pipeline;
 pub mod plot;
+pub mod proc_stats;
 pub mod qiu;
 pub mod replay;
 pub mod simulate;

@@ -1,4 +1,4 @@
-//! `curbtrace` — road edges from mobile laser scanning point clouds (SPEC §4).
+//! `curbtrace` — road edges from mobile laser scanning point clouds (docs/spec.md §4).
 //!
 //! Each subcommand lives in its own file under `host-sim/src/cli/`.
 
@@ -25,7 +25,7 @@ enum Command {
     Extract(cli::extract::Args),
     /// Simulates a mobile laser scanning scene: points.laz, trajectory.csv, reference.geojson.
     Simulate(cli::simulate::Args),
-    /// Scores extracted edges against reference lines (Heipke et al. 1997, SPEC §5).
+    /// Scores extracted edges against reference lines (Heipke et al. 1997, docs/spec.md §5).
     Eval(cli::eval::Args),
     /// Writes the core's input byte stream for a LAS/LAZ file and its trajectory.
     Replay(cli::replay::Args),

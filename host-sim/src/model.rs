@@ -1,9 +1,9 @@
-//! Shared types of the host side: sides, categories, polylines and edges, and their GeoJSON
-//! form (SPEC §3). Everything in world coordinates is `f64`.
+//! Shared types of the host side: sides, categories, polylines and edges, and reading their
+//! GeoJSON form (docs/spec.md §3; writing is in `output`). Everything in world coordinates is `f64`.
 
 use serde::{Deserialize, Serialize};
 
-/// Left or right relative to the driving direction (SPEC §2).
+/// Left or right relative to the driving direction (docs/spec.md §2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Side {
@@ -23,7 +23,7 @@ impl Side {
     }
 }
 
-/// What kind of road edge a line is (SPEC §3).
+/// What kind of road edge a line is (docs/spec.md §3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Category {
@@ -149,79 +149,6 @@ pub enum GeoJsonError {
     },
 }
 
-/// Serialises lines as a GeoJSON FeatureCollection with the legacy `crs` member.
-pub fn lines_to_geojson(lines: &[EdgeLine], crs: Option<&Crs>) -> serde_json::Value {
-    use serde_json::{json, Map, Value};
-    let features: Vec<Value> = lines
-        .iter()
-        .map(|l| {
-            let mut props = Map::new();
-            props.insert("side".into(), json!(l.side.as_str()));
-            if let Some(c) = l.category {
-                props.insert("category".into(), json!(c.as_str()));
-            }
-            if let Some(m) = &l.method {
-                props.insert("method".into(), json!(m));
-            }
-            props.insert("length_m".into(), json!(round_to(l.length_m(), 1e-3)));
-            if let Some(h) = l.curb_height_m {
-                props.insert("curb_height_m".into(), json!(round_to(h, 1e-4)));
-            }
-            let coords: Vec<Value> = l
-                .points
-                .iter()
-                .map(|p| {
-                    json!([
-                        round_to(p[0], 1e-4),
-                        round_to(p[1], 1e-4),
-                        round_to(p[2], 1e-4)
-                    ])
-                })
-                .collect();
-            json!({
-                "type": "Feature",
-                "properties": Value::Object(props),
-                "geometry": { "type": "LineString", "coordinates": coords },
-            })
-        })
-        .collect();
-    let mut fc = Map::new();
-    fc.insert("type".into(), json!("FeatureCollection"));
-    if let Some(crs) = crs {
-        let name = match crs {
-            Crs::Epsg(code) => format!("urn:ogc:def:crs:EPSG::{code}"),
-            Crs::Wkt(wkt) => wkt.clone(),
-        };
-        fc.insert(
-            "crs".into(),
-            json!({ "type": "name", "properties": { "name": name } }),
-        );
-    }
-    fc.insert("features".into(), Value::Array(features));
-    Value::Object(fc)
-}
-
-fn round_to(v: f64, step: f64) -> f64 {
-    (v / step).round() * step
-}
-
-/// Writes lines to a GeoJSON file.
-pub fn write_geojson(
-    path: &std::path::Path,
-    lines: &[EdgeLine],
-    crs: Option<&Crs>,
-) -> Result<(), GeoJsonError> {
-    let v = lines_to_geojson(lines, crs);
-    let text = serde_json::to_string(&v).map_err(|e| GeoJsonError::Format {
-        path: path.display().to_string(),
-        what: e.to_string(),
-    })?;
-    std::fs::write(path, text).map_err(|source| GeoJsonError::Io {
-        path: path.display().to_string(),
-        source,
-    })
-}
-
 /// Reads LineString / MultiLineString features from a GeoJSON file. A MultiLineString
 /// becomes one [`EdgeLine`] per part. `side` is required; `category`, `method` and
 /// `curb_height_m` are optional.
@@ -335,6 +262,7 @@ pub fn read_geojson(path: &std::path::Path) -> Result<(Vec<EdgeLine>, Option<Crs
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::output::geojson::write_geojson;
 
     #[test]
     fn geojson_round_trip_keeps_properties_and_crs() {

@@ -10,6 +10,7 @@ use crate::io::trajectory::{Trajectory, TrajectoryError};
 use crate::model::{Crs, EdgeLine};
 use crate::replay::run::{self, KernelResults, ReplayCounters, ReplayError};
 use std::path::{Path, PathBuf};
+use crate::proc_stats::{peak_rss_bytes, process_cpu_s};
 use std::time::Instant;
 
 /// Errors of the whole extraction; every message names the file and the problem.
@@ -115,38 +116,7 @@ impl Progress {
     }
 }
 
-/// CPU time (user + system, all threads) of this process so far, seconds, from
-/// `/proc/self/stat` (Linux; 0 elsewhere). On a shared machine wall time says little; CPU
-/// time per stage says where the work goes.
-pub fn process_cpu_s() -> f64 {
-    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
-        return 0.0;
-    };
-    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
-    let Some(rest) = stat.rsplit(')').next() else {
-        return 0.0;
-    };
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
-    // rest starts at field 3 (state): field k is f[k - 3]. Linux clock ticks are 100 Hz.
-    (ticks(11) + ticks(12)) / 100.0
-}
-
-/// Peak resident memory of this process so far (VmHWM of `/proc/self/status`), bytes; 0
-/// where unavailable.
-pub fn peak_rss_bytes() -> u64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1))
-                .and_then(|v| v.parse::<u64>().ok())
-        })
-        .map_or(0, |kb| kb * 1024)
-}
-
-/// CPU seconds per stage (all threads), see [`process_cpu_s`].
+/// CPU seconds per stage (all threads), see [`process_cpu_s`](crate::proc_stats::process_cpu_s).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StageCpu {
     /// Reading the point file.
@@ -484,24 +454,4 @@ fn extract_qiu(
         edges,
         summary,
     })
-}
-
-/// Writes edges as CSV vertex lists: `edge,side,vertex,x,y,z` (one row per vertex).
-pub fn write_edges_csv(path: &Path, edges: &[EdgeLine]) -> std::io::Result<()> {
-    use std::io::Write;
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(w, "edge,side,vertex,x,y,z")?;
-    for (k, e) in edges.iter().enumerate() {
-        for (v, p) in e.points.iter().enumerate() {
-            writeln!(
-                w,
-                "{k},{},{v},{:.4},{:.4},{:.4}",
-                e.side.as_str(),
-                p[0],
-                p[1],
-                p[2]
-            )?;
-        }
-    }
-    w.flush()
 }

@@ -1,5 +1,4 @@
-//! Issue 4, done when: a straight road with curbs on both sides (toe lines known),
-//! `curbtrace extract` finds both with an RMS under 20 mm and nothing else.
+//! A straight road with curbs on both sides (toe lines known): `curbtrace extract` finds both with an RMS under 20 mm and nothing else.
 
 mod common;
 

@@ -1,6 +1,6 @@
 //! End-to-end: simulate a scene, extract road edges through the whole product (LAZ →
 //! projection → wire bytes → core → seeding/tracking/post-filters), score them against the
-//! simulator's ground truth (SPEC §5), and assert the accuracy targets of the accuracy issue
+//! simulator's ground truth (docs/spec.md §5), and assert the accuracy targets
 //! (completeness ≥ 95 %, correctness ≥ 95 %, quality ≥ 90 %, RMS ≤ 20 mm at a 50 mm buffer)
 //! with the one set of default parameters.
 //!

@@ -7,7 +7,8 @@
 //! on every run and whatever the thread count.
 
 use crate::io::trajectory::Trajectory;
-use crate::model::{EdgeLine, Side};
+use crate::model::EdgeLine;
+use crate::replay::{Candidate, PointStatus};
 
 pub mod grid;
 pub mod params;
@@ -17,26 +18,6 @@ pub mod seed;
 pub mod track;
 
 pub use params::BendParams;
-
-/// A seed candidate from the core: the first peak outward from the nadir on one side of
-/// one scanline.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Candidate {
-    /// Index into the point columns (the tag sent through the core).
-    pub point: u32,
-    /// Which side of the trajectory.
-    pub side: Side,
-    /// Scanline number.
-    pub scanline: u32,
-}
-
-/// Status value meaning "kept, with a bend angle" (mirrors `curbtrace_core::kernel::PointStatus::Kept`).
-pub const STATUS_KEPT: u8 = 0;
-/// Status value for "kept, but no neighbour within d_b on one side, so no ρ" (mirrors
-/// `curbtrace_core::kernel::PointStatus::NoNeighbour`).
-pub const STATUS_NO_NEIGHBOUR: u8 = 2;
-/// Status value for points that never reached the kernel (outside the trajectory, dropped).
-pub const STATUS_NOT_PROCESSED: u8 = 255;
 
 /// Everything the host half of the bend method reads. All slices are indexed by point
 /// (the columns of `io::las_in`, sorted by time).
@@ -51,9 +32,9 @@ pub struct BendInput<'a> {
     pub t: &'a [f64],
     /// Bend angle on the smoothed scanline from the core, degrees (0 unless kept).
     pub rho_deg: &'a [f32],
-    /// `PointStatus as u8` from the core, or [`STATUS_NOT_PROCESSED`].
-    pub status: &'a [u8],
-    /// Scanline number per point (`u32::MAX` when not processed).
+    /// The core's status per point; `None` for points the core never returned.
+    pub status: &'a [Option<PointStatus>],
+    /// Scanline number per point, meaningful where the status is `Some`.
     pub scanline: &'a [u32],
     /// The core's seed candidates.
     pub candidates: &'a [Candidate],
@@ -101,9 +82,7 @@ pub fn extract_edges(input: &BendInput, params: &BendParams) -> Vec<EdgeLine> {
     // One index over every processed point: tracking reads the kept ones, the vehicle
     // filter and the height step read all.
     let cell_m = params.search_radius_m.clamp(0.05, 1.0);
-    let grid = grid::PointGrid::build(input.x, input.y, cell_m, |i| {
-        input.status[i] != STATUS_NOT_PROCESSED
-    });
+    let grid = grid::PointGrid::build(input.x, input.y, cell_m, |i| input.status[i].is_some());
     let mut seeds = seed::seed_points(&input, &route, params);
     // Best-fitting seeds first: the first track along a curb claims it, later seeds on the
     // same curb start nothing.
@@ -125,7 +104,5 @@ pub fn extract_edges(input: &BendInput, params: &BendParams) -> Vec<EdgeLine> {
     postfilter::to_edge_lines(&input, &grid, &route, &tracks, params)
 }
 
-#[cfg(test)]
-mod devrun;
 #[cfg(test)]
 mod tests;

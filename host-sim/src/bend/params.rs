@@ -69,9 +69,7 @@ pub struct BendParams {
     /// `stop_rho_deg` (extrapolating along the search direction, turning at the running
     /// turn rate) before it stops. 0 is the paper's rule. Not in the paper; 6 steps (0.9 m)
     /// bridge the weak toes of curb cuts and the stretches of intersection corners that run
-    /// along a scanline: on the simulated `kawasaki` scene with the core's output it raised
-    /// total quality from 95.8 % to 97.8 % (right curb cuts 53 % → 100 %), while 10 steps
-    /// gave the same.
+    /// along a scanline; the effect on the named scenes is in docs/benchmarks.md.
     pub max_gap_steps: u32,
     /// Whether a step whose search set S holds no point with ρ at or above `stop_rho_deg`
     /// looks for the toe on a virtual profile across the search direction, built from the

@@ -15,7 +15,8 @@ use super::grid::PointGrid;
 use super::params::BendParams;
 use super::route::Route;
 use super::track::Track;
-use super::{BendInput, STATUS_NOT_PROCESSED};
+use super::BendInput;
+use crate::replay::PointStatus;
 use crate::model::{Category, EdgeLine};
 
 fn pos(input: &BendInput, p: u32) -> [f64; 3] {
@@ -230,7 +231,7 @@ pub fn height_steps(
         let mut outer = Vec::new();
         let r = (g + w).hypot(along_max);
         grid.for_each_within(input.x, input.y, xy[k][0], xy[k][1], r, |i| {
-            if input.status[i] == STATUS_NOT_PROCESSED {
+            if input.status[i].is_none() {
                 return;
             }
             let d = [input.x[i] - xy[k][0], input.y[i] - xy[k][1]];
@@ -336,7 +337,7 @@ fn refined_pos(input: &BendInput, p: u32) -> [f64; 3] {
         return here;
     }
     let ok =
-        |j: usize| input.status[j] == super::STATUS_KEPT && input.scanline[j] == input.scanline[i];
+        |j: usize| input.status[j] == Some(PointStatus::Kept) && input.scanline[j] == input.scanline[i];
     if !(ok(i - 1) && ok(i + 1)) {
         return here;
     }
@@ -524,7 +525,7 @@ mod tests {
             z: &[1.0; 3],
             t: &[0.0; 3],
             rho_deg: &[60.0, 90.0, 80.0],
-            status: &[0; 3],
+            status: &[Some(PointStatus::Kept); 3],
             scanline: &[4; 3],
             candidates: &[],
             trajectory: &traj,

@@ -80,7 +80,7 @@ impl Route {
         Some(self.s[k] + (self.s[next] - self.s[k]) * w)
     }
 
-    /// Horizontal forward unit vector at time `t` (from the heading, SPEC §2).
+    /// Horizontal forward unit vector at time `t` (from the heading, docs/spec.md §2).
     pub fn forward_at(&self, t: f64) -> Option<[f64; 2]> {
         let (k, w) = self.bracket(t)?;
         let next = (k + 1).min(self.s.len() - 1);

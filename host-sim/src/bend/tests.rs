@@ -12,6 +12,8 @@ use rand_distr::{Distribution, Normal};
 use super::*;
 use crate::io::trajectory::Pose;
 use crate::model::Category;
+use crate::model::Side;
+use crate::replay::{Candidate, PointStatus};
 
 const X0: f64 = 500_000.0;
 const Y0: f64 = 4_000_000.0;
@@ -44,7 +46,7 @@ struct Scene {
     z: Vec<f64>,
     t: Vec<f64>,
     rho: Vec<f32>,
-    status: Vec<u8>,
+    status: Vec<Option<PointStatus>>,
     scanline: Vec<u32>,
     candidates: Vec<Candidate>,
     /// Dense toe polylines (left, right) where there is a curb, one per continuous piece.
@@ -176,7 +178,7 @@ fn make_scene(cfg: &SceneCfg) -> Scene {
                     sc.z.push(zz);
                     sc.t.push(t_line);
                     sc.rho.push(-30.0);
-                    sc.status.push(STATUS_KEPT);
+                    sc.status.push(Some(PointStatus::Kept));
                     sc.scanline.push(line as u32);
                 }
             } else if !occluded {
@@ -187,7 +189,11 @@ fn make_scene(cfg: &SceneCfg) -> Scene {
                 sc.rho.push(rho as f32);
                 // A few points removed as irregular by the core: no ρ.
                 let irregular = rng.gen_range(0..50) == 0;
-                sc.status.push(if irregular { 1 } else { STATUS_KEPT });
+                sc.status.push(Some(if irregular {
+                    PointStatus::Irregular
+                } else {
+                    PointStatus::Kept
+                }));
                 if irregular {
                     *sc.rho.last_mut().unwrap() = 0.0;
                 }
@@ -532,7 +538,7 @@ fn bad_input_gives_nothing_and_does_not_panic() {
         z: &[],
         t: &[0.0],
         rho_deg: &[90.0],
-        status: &[0],
+        status: &[Some(PointStatus::Kept)],
         scanline: &[0],
         candidates: &[Candidate {
             point: 7,
@@ -558,7 +564,7 @@ fn timing_300_m() {
     let p = BendParams::default();
     let t0 = std::time::Instant::now();
     let route = route::Route::new(&sc.traj);
-    let grid = grid::PointGrid::build(input.x, input.y, 0.1, |i| input.status[i] != 255);
+    let grid = grid::PointGrid::build(input.x, input.y, 0.1, |i| input.status[i].is_some());
     let t1 = t0.elapsed().as_secs_f64();
     let seeds = seed::seed_points(&input, &route, &p);
     let t2 = t0.elapsed().as_secs_f64();

@@ -13,7 +13,8 @@ use std::collections::HashMap;
 use super::grid::PointGrid;
 use super::params::BendParams;
 use super::seed::Seed;
-use super::{BendInput, STATUS_KEPT, STATUS_NO_NEIGHBOUR};
+use super::BendInput;
+use crate::replay::PointStatus;
 use crate::model::Side;
 
 /// One tracked edge: its vertices in order along the driving direction.
@@ -173,7 +174,7 @@ pub fn track_edges(
 
     for seed in seeds {
         let s = seed.point as usize;
-        if s >= input.x.len() || input.status.get(s) != Some(&STATUS_KEPT) {
+        if s >= input.x.len() || input.status.get(s) != Some(&Some(PointStatus::Kept)) {
             continue;
         }
         let id = tracks.len();
@@ -326,7 +327,10 @@ fn up_side(input: &BendInput, grid: &PointGrid, i: usize, dir: [f64; 2]) -> Opti
 
 /// Points a virtual profile may use: kept by the core, with or without a bend angle.
 fn usable(input: &BendInput, i: usize) -> bool {
-    input.status[i] == STATUS_KEPT || input.status[i] == STATUS_NO_NEIGHBOUR
+    matches!(
+        input.status[i],
+        Some(PointStatus::Kept | PointStatus::NoNeighbour)
+    )
 }
 
 /// A curb toe found on a virtual profile.
@@ -581,7 +585,7 @@ fn track_one_way(
             pred[1],
             params.search_radius_m,
             |i| {
-                if input.status[i] != STATUS_KEPT
+                if input.status[i] != Some(PointStatus::Kept)
                     || (input.z[i] - pred[2]).abs() > params.search_half_height_m
                     || own_pts.contains(&(i as u32))
                 {
@@ -747,7 +751,7 @@ mod tests {
         z: Vec<f64>,
         t: Vec<f64>,
         rho: Vec<f32>,
-        status: Vec<u8>,
+        status: Vec<Option<PointStatus>>,
         scanline: Vec<u32>,
         traj: Trajectory,
     }
@@ -802,7 +806,7 @@ mod tests {
                 c.z.push(if up { 0.15 } else { 0.0 });
                 c.t.push(line as f64 * 0.01 + y * 1e-5);
                 c.rho.push(rho as f32);
-                c.status.push(STATUS_KEPT);
+                c.status.push(Some(PointStatus::Kept));
                 c.scanline.push(line);
                 y += 0.02;
             }

@@ -1,8 +1,8 @@
-//! `curbtrace extract POINTS --trajectory CSV -o EDGES.geojson` — the main job (SPEC §4).
+//! `curbtrace extract POINTS --trajectory CSV -o EDGES.geojson` — the main job (docs/spec.md §4).
 
 use anyhow::Context;
 use curbtrace_host_sim::config::Config;
-use curbtrace_host_sim::model;
+use curbtrace_host_sim::output;
 use curbtrace_host_sim::pipeline::{self, ExtractOptions, Method, Progress};
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -10,7 +10,7 @@ use std::path::PathBuf;
 /// Output format of the edges.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
-    /// GeoJSON FeatureCollection with the LAS CRS (SPEC §3).
+    /// GeoJSON FeatureCollection with the LAS CRS (docs/spec.md §3).
     Geojson,
     /// Plain vertex lists: `edge,side,vertex,x,y,z`.
     Csv,
@@ -90,8 +90,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let result = pipeline::extract_file_with(points, trajectory, &cfg, &opts, &progress)?;
     progress.finish();
     match args.format {
-        Format::Geojson => model::write_geojson(output, &result.edges, result.crs.as_ref())?,
-        Format::Csv => pipeline::write_edges_csv(output, &result.edges)
+        Format::Geojson => output::geojson::write_geojson(output, &result.edges, result.crs.as_ref())?,
+        Format::Csv => output::csv::write_edges(output, &result.edges)
             .with_context(|| format!("{}: writing the edges", output.display()))?,
     }
     if !args.quiet {

@@ -1,4 +1,4 @@
-//! Where scanlines start in a LAS file (SPEC §2): the core's assembler splits lines at the
+//! Where scanlines start in a LAS file (docs/spec.md §2): the core's assembler splits lines at the
 //! stream's line-start flag when the source sets it. A LAS file has no line numbers, so the
 //! replay derives them:
 //!
@@ -14,7 +14,7 @@
 //! 2. **GPS time and the line period** (`[replay] line_period_s` in the config), when the
 //!    scan angle carries no information: line k holds the points with
 //!    ⌊(t − t₀) / period⌋ = k.
-//! 3. **Neither**: no flags; the core splits lines itself (its no-flag rule, SPEC §2).
+//! 3. **Neither**: no flags; the core splits lines itself (its no-flag rule, docs/spec.md §2).
 
 /// How line starts are derived (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,5 +1,5 @@
 //! Step (a) of Honma et al. (§2.2, Eq. 1–2), in `f64` on the host: each point is moved into
-//! the vehicle-level frame of the scanner at its own time t (SPEC §2):
+//! the vehicle-level frame of the scanner at its own time t (docs/spec.md §2):
 //!
 //! x′ = (p − q(t)) · l(t),  z′ = p_z − q_z(t),  l = (−cos h, sin h, 0),
 //!

@@ -17,7 +17,7 @@
 
 use super::line_start::{LineRule, LineStartParams};
 use super::project::{project_point, PoseCursor};
-use crate::bend::{Candidate, STATUS_NOT_PROCESSED};
+use super::{Candidate, PointStatus};
 use crate::io::las_in::PointColumns;
 use crate::io::trajectory::Trajectory;
 use crate::model::Side;
@@ -152,9 +152,9 @@ impl ReplayCounters {
 pub struct KernelResults {
     /// ρ on the smoothed line, degrees (0 unless kept).
     pub rho_deg: Vec<f32>,
-    /// `PointStatus as u8`, or [`STATUS_NOT_PROCESSED`].
-    pub status: Vec<u8>,
-    /// Global scanline number (`u32::MAX` when not processed).
+    /// The core's status per point; `None` for points it never returned.
+    pub status: Vec<Option<PointStatus>>,
+    /// Global scanline number, meaningful where the status is `Some`.
     pub scanline: Vec<u32>,
     /// Seed candidates, in scanline order.
     pub candidates: Vec<Candidate>,
@@ -259,7 +259,7 @@ struct ChunkOut {
 /// A chunk's share of the per-point outputs.
 struct ChunkSlices<'a> {
     rho: &'a mut [f32],
-    status: &'a mut [u8],
+    status: &'a mut [Option<PointStatus>],
     line: &'a mut [u32],
 }
 
@@ -288,7 +288,7 @@ fn run_chunk(
                 continue;
             };
             rho[j] = o.rho_deg[k];
-            status[j] = o.status[k] as u8;
+            status[j] = Some(o.status[k]);
             line[j] = o.index;
         }
         out.counters.kept += u64::from(o.counters.kept);
@@ -345,8 +345,8 @@ pub fn run_kernel(
     let rule = LineRule::choose(&cols.scan_angle_deg, &cols.t, &params.line());
     let ranges = chunks(cols, &rule, params.chunk_points);
     let mut rho = vec![0f32; n];
-    let mut status = vec![STATUS_NOT_PROCESSED; n];
-    let mut scanline = vec![u32::MAX; n];
+    let mut status = vec![None; n];
+    let mut scanline = vec![0u32; n];
     // Disjoint output slices per chunk.
     let mut parts = Vec::with_capacity(ranges.len());
     {
@@ -417,15 +417,10 @@ pub fn run_kernel(
         .zip(bases.par_iter())
         .for_each(|(sl, &b)| {
             if b > 0 {
-                sl.iter_mut()
-                    .filter(|v| **v != u32::MAX)
-                    .for_each(|v| *v += b);
+                sl.iter_mut().for_each(|v| *v += b);
             }
         });
-    let returned = status
-        .iter()
-        .filter(|&&s| s != STATUS_NOT_PROCESSED)
-        .count() as u64;
+    let returned = status.iter().filter(|s| s.is_some()).count() as u64;
     counters.lost =
         counters.points_sent - returned - counters.truncated.min(counters.points_sent - returned);
     Ok(KernelResults {

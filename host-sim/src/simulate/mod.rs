@@ -268,7 +268,7 @@ pub fn run(
     let crs = write::wkt_for(spec.epsg)
         .map(Crs::Wkt)
         .unwrap_or(Crs::Epsg(spec.epsg));
-    crate::model::write_geojson(&reference_path, &sim.reference, Some(&crs)).map_err(|e| {
+    crate::output::geojson::write_geojson(&reference_path, &sim.reference, Some(&crs)).map_err(|e| {
         SimError::Write {
             path: reference_path.display().to_string(),
             what: e.to_string(),

@@ -1,0 +1,76 @@
+//! Edges as a GeoJSON FeatureCollection with the legacy `crs` member (docs/spec.md §3).
+
+use crate::model::{Crs, EdgeLine, GeoJsonError};
+
+/// Serialises lines as a GeoJSON FeatureCollection with the legacy `crs` member.
+pub fn lines_to_geojson(lines: &[EdgeLine], crs: Option<&Crs>) -> serde_json::Value {
+    use serde_json::{json, Map, Value};
+    let features: Vec<Value> = lines
+        .iter()
+        .map(|l| {
+            let mut props = Map::new();
+            props.insert("side".into(), json!(l.side.as_str()));
+            if let Some(c) = l.category {
+                props.insert("category".into(), json!(c.as_str()));
+            }
+            if let Some(m) = &l.method {
+                props.insert("method".into(), json!(m));
+            }
+            props.insert("length_m".into(), json!(round_to(l.length_m(), 1e-3)));
+            if let Some(h) = l.curb_height_m {
+                props.insert("curb_height_m".into(), json!(round_to(h, 1e-4)));
+            }
+            let coords: Vec<Value> = l
+                .points
+                .iter()
+                .map(|p| {
+                    json!([
+                        round_to(p[0], 1e-4),
+                        round_to(p[1], 1e-4),
+                        round_to(p[2], 1e-4)
+                    ])
+                })
+                .collect();
+            json!({
+                "type": "Feature",
+                "properties": Value::Object(props),
+                "geometry": { "type": "LineString", "coordinates": coords },
+            })
+        })
+        .collect();
+    let mut fc = Map::new();
+    fc.insert("type".into(), json!("FeatureCollection"));
+    if let Some(crs) = crs {
+        let name = match crs {
+            Crs::Epsg(code) => format!("urn:ogc:def:crs:EPSG::{code}"),
+            Crs::Wkt(wkt) => wkt.clone(),
+        };
+        fc.insert(
+            "crs".into(),
+            json!({ "type": "name", "properties": { "name": name } }),
+        );
+    }
+    fc.insert("features".into(), Value::Array(features));
+    Value::Object(fc)
+}
+
+fn round_to(v: f64, step: f64) -> f64 {
+    (v / step).round() * step
+}
+
+/// Writes lines to a GeoJSON file.
+pub fn write_geojson(
+    path: &std::path::Path,
+    lines: &[EdgeLine],
+    crs: Option<&Crs>,
+) -> Result<(), GeoJsonError> {
+    let v = lines_to_geojson(lines, crs);
+    let text = serde_json::to_string(&v).map_err(|e| GeoJsonError::Format {
+        path: path.display().to_string(),
+        what: e.to_string(),
+    })?;
+    std::fs::write(path, text).map_err(|source| GeoJsonError::Io {
+        path: path.display().to_string(),
+        source,
+    })
+}
