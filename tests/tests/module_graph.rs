@@ -355,11 +355,13 @@ fn the_host_has_no_cycle_and_imports_downwards() {
         "host-sim/src",
         &[
             ("model", 0),
+            ("proc_stats", 0),
             ("io", 1),
             ("replay", 2),
             ("bend", 3),
             ("qiu", 3),
             ("config", 4),
+            ("output", 4),
             ("pipeline", 5),
             ("simulate", 6),
             ("plot", 6),
