@@ -179,7 +179,12 @@ impl Summary {
     pub fn to_text(&self) -> String {
         let c = &self.core;
         let pts_per_s = self.points_read() as f64 / self.times.total_s.max(1e-9);
-        let per = self.points_read().max(1) as f64;
+        // An empty sum of lengths is -0.0; "-0.0 m" would read as a sign error.
+        let len = if self.total_length_m == 0.0 {
+            0.0
+        } else {
+            self.total_length_m
+        };
         format!(
             "points read        {read} of {file} in {path}\n\
              dropped            {before} before and {after} after the trajectory, {trunc} in over-long lines, {lost} lost in the core, {irr} irregular (§2.4), {nn} without neighbours\n\
@@ -188,7 +193,7 @@ impl Summary {
              edges              {edges}, total length {len:.1} m\n\
              time               {total:.2} s ({pts:.2} M points/s): read {r:.2} s, trajectory {t:.2} s, core {k:.2} s, edges {e:.2} s\n\
              cpu                {ctot:.2} s: read {cr:.2} s, core {ck:.2} s, edges {ce:.2} s\n\
-             peak memory        {m0:.1} B/point after reading, {m1:.1} after the core, {m2:.1} after the edges",
+             peak memory        {mem}",
             read = self.points_read(),
             file = self.las.points_in_file,
             path = self.las.path.display(),
@@ -201,7 +206,6 @@ impl Summary {
             lines = c.scanlines,
             cand = self.candidates,
             edges = self.edges,
-            len = self.total_length_m,
             total = self.times.total_s,
             pts = pts_per_s / 1e6,
             r = self.times.read_s,
@@ -212,10 +216,33 @@ impl Summary {
             cr = self.times.cpu.read_s,
             ck = self.times.cpu.core_s,
             ce = self.times.cpu.edges_s,
-            m0 = self.times.cpu.peak_rss[0] as f64 / per,
-            m1 = self.times.cpu.peak_rss[1] as f64 / per,
-            m2 = self.times.cpu.peak_rss[2] as f64 / per,
+            mem = self.peak_memory_text(),
         )
+    }
+
+    /// Peak memory per stage: bytes per point read when there are enough points for the
+    /// process's fixed footprint (code, libraries, thread stacks: some MiB) not to dominate
+    /// the figure, MiB otherwise.
+    fn peak_memory_text(&self) -> String {
+        const PER_POINT_FROM: u64 = 1_000_000;
+        let [m0, m1, m2] = self.times.cpu.peak_rss.map(|b| b as f64);
+        if self.points_read() >= PER_POINT_FROM {
+            let per = self.points_read() as f64;
+            format!(
+                "{:.1} B/point after reading, {:.1} after the core, {:.1} after the edges",
+                m0 / per,
+                m1 / per,
+                m2 / per
+            )
+        } else {
+            let mib = f64::from(1u32 << 20);
+            format!(
+                "{:.1} MiB after reading, {:.1} MiB after the core, {:.1} MiB after the edges",
+                m0 / mib,
+                m1 / mib,
+                m2 / mib
+            )
+        }
     }
 }
 

@@ -89,6 +89,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let result = pipeline::extract_file_with(points, trajectory, &cfg, &opts, &progress)?;
     progress.finish();
+    if let (Format::Geojson, None) = (args.format, &result.crs) {
+        let why = result.summary.las.no_crs.map_or_else(
+            || "the input's CRS was not kept".to_string(),
+            |w| w.to_string(),
+        );
+        eprintln!(
+            "warning: {}: the output has no CRS: {why} ({})",
+            output.display(),
+            points.display()
+        );
+    }
     match args.format {
         Format::Geojson => output::geojson::write_geojson(output, &result.edges, result.crs.as_ref())?,
         Format::Csv => output::csv::write_edges(output, &result.edges)

@@ -22,7 +22,7 @@ pub const CHUNK_POINTS: u64 = 1 << 18;
 const MAX_SLAB_BYTES: u64 = 64 << 20;
 
 /// Opens the `las` crate's reader on a file whose header passed the checks.
-pub(super) fn open_reader(path: &Path) -> Result<Reader, LasError> {
+pub(super) fn open_reader(path: &Path, head: &FileHead) -> Result<Reader, LasError> {
     let file = File::open(path).map_err(|source| LasError::Io {
         path: path.to_path_buf(),
         source,
@@ -31,7 +31,7 @@ pub(super) fn open_reader(path: &Path) -> Result<Reader, LasError> {
         BufReader::with_capacity(1 << 20, file),
         ReaderOptions::default(),
     )
-    .map_err(|e| las_error(path, e, "reading the header and VLRs"))
+    .map_err(|e| las_error(path, head, e, "reading the header and VLRs"))
 }
 
 /// Decodes every point of `reader` and appends the ones `selector` keeps to `cols`;
@@ -57,7 +57,13 @@ pub(super) fn decode_points(
     loop {
         let n = reader
             .fill_points(batch.min(total.saturating_sub(done)), &mut pd)
-            .map_err(|e| las_error(path, e, &format!("decoding points after point {done}")))?;
+            .map_err(|e| {
+                let stage = format!(
+                    "decoding points {done}–{}",
+                    done + batch.min(total.saturating_sub(done))
+                );
+                las_error(path, head, e, &stage)
+            })?;
         if n == 0 {
             break;
         }
@@ -110,39 +116,49 @@ pub(super) fn decode_points(
         }
     }
     if done < total {
-        return Err(LasError::Truncated {
+        return Err(LasError::Corrupt {
             path: path.to_path_buf(),
-            what: format!("the header says {total} points but only {done} could be decoded"),
+            what: format!("the header says {total} points but the point data holds only {done}"),
         });
     }
     Ok(done)
 }
 
-/// Maps a `las` crate error to a one-line message naming the file, the stage, and whether
-/// the file looks truncated.
-fn las_error(path: &Path, e: las::Error, stage: &str) -> LasError {
-    // Walk the cause chain: an unexpected end of file anywhere in it (LAS read_exact, or
-    // the LAZ decoder's reader) means the file is shorter than its header says.
-    let mut truncated = false;
-    let mut cause: Option<&(dyn std::error::Error + 'static)> = Some(&e);
-    while let Some(c) = cause {
-        if let Some(io) = c.downcast_ref::<std::io::Error>() {
-            truncated |= io.kind() == std::io::ErrorKind::UnexpectedEof;
+/// Maps a `las` crate error while `stage` to a one-line message naming the file.
+///
+/// The checks before decoding have placed every byte the header promises inside the file:
+/// the uncompressed records, or the LAZ chunk table after the compressed ones. So a LAZ
+/// decoder error is corrupt data, named with the points it was decoding, and only an
+/// uncompressed file can still end early (if it shrinks while being read).
+fn las_error(path: &Path, head: &FileHead, e: las::Error, stage: &str) -> LasError {
+    let path = path.to_path_buf();
+    match e {
+        las::Error::LasZipError(lz) => LasError::Corrupt {
+            path,
+            what: format!(
+                "LAZ point data while {stage}: {}",
+                super::laz::laz_reason(&lz)
+            ),
+        },
+        las::Error::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
+            if head.compressed {
+                LasError::Corrupt {
+                    path,
+                    what: format!(
+                        "LAZ point data while {stage}: the compressed data ends before the points it should hold"
+                    ),
+                }
+            } else {
+                LasError::Truncated {
+                    path,
+                    what: format!("the file ends while {stage}"),
+                }
+            }
         }
-        cause = c.source();
-    }
-    // The LAZ decoder flattens its io::Error into its own type without a source.
-    let text = e.to_string();
-    truncated |= text.contains("failed to fill whole buffer") || text.contains("UnexpectedEof");
-    if truncated {
-        LasError::Truncated {
-            path: path.to_path_buf(),
-            what: format!("unexpected end of file while {stage}"),
-        }
-    } else {
-        LasError::Las {
-            path: path.to_path_buf(),
+        las::Error::Io(source) => LasError::Io { path, source },
+        e => LasError::Las {
+            path,
             what: format!("{stage}: {e}"),
-        }
+        },
     }
 }

@@ -26,7 +26,68 @@ pub enum LasError {
         /// The file.
         path: PathBuf,
     },
-    /// The file ends inside the header, the VLRs, or the point records.
+    /// The LAS version is not one this reader knows.
+    #[error("{path}: LAS version {major}.{minor} is not supported; curbtrace reads LAS 1.0–1.4")]
+    UnsupportedVersion {
+        /// The file.
+        path: PathBuf,
+        /// Major version.
+        major: u8,
+        /// Minor version.
+        minor: u8,
+    },
+    /// The header's point format byte names no LAS point format.
+    #[error("{path}: the header's point format byte {byte} names no LAS point format (0–10, plus 128 for LAZ)")]
+    BadFormat {
+        /// The file.
+        path: PathBuf,
+        /// The point data record format byte.
+        byte: u8,
+    },
+    /// The point records are shorter than their format's fields.
+    #[error("{path}: point records of {record_len} bytes are too short for point format {format}, which needs {need} bytes")]
+    ShortRecords {
+        /// The file.
+        path: PathBuf,
+        /// The point data record format.
+        format: u8,
+        /// Record length in the header.
+        record_len: u16,
+        /// The format's length without extra bytes.
+        need: u16,
+    },
+    /// A scale factor that is not a positive finite number, or an offset that is not finite.
+    #[error("{path}: the header's {axis} {field} is {value}; {rule}")]
+    BadTransform {
+        /// The file.
+        path: PathBuf,
+        /// `x`, `y` or `z`.
+        axis: char,
+        /// `scale` or `offset`.
+        field: &'static str,
+        /// The value.
+        value: f64,
+        /// What it must be.
+        rule: &'static str,
+    },
+    /// Fields that contradict each other, or data that does not decode.
+    #[error("{path}: corrupt file: {what}")]
+    Corrupt {
+        /// The file.
+        path: PathBuf,
+        /// What contradicts what, and where.
+        what: String,
+    },
+    /// A valid file that uses something this reader does not decode.
+    #[error("{path}: {what}")]
+    Unsupported {
+        /// The file.
+        path: PathBuf,
+        /// What, and what to do about it.
+        what: String,
+    },
+    /// The file is shorter than its header says: it ends inside the header, the VLRs, the
+    /// point records or the extended VLRs.
     #[error("{path}: truncated file: {what}")]
     Truncated {
         /// The file.

@@ -1,6 +1,6 @@
 //! LAZ specifics, checked before the `laz` crate sees the file: the `laszip encoded` VLR
-//! (its items against the point record, its chunk size) and the chunk table (where it is,
-//! how many chunks it claims).
+//! (its compressor, its items against the point record, its chunk size) and the chunk table
+//! (where it is, how many chunks it claims), and the crate's errors as sentences.
 
 use super::header::FileHead;
 use super::LasError;
@@ -27,48 +27,95 @@ pub(super) fn laszip_vlr(vlrs: &[las::raw::Vlr]) -> Option<&las::raw::Vlr> {
     })
 }
 
-/// The `laszip encoded` VLR's item list, checked before the `laz` crate uses it: the items'
-/// sizes must add up to the header's point record length (the crate divides by that sum,
-/// and a zero sum panicked in its parallel decompressor), and a fixed chunk of points must
-/// not ask for more than 1 GiB of decompression buffer.
+/// What the `laszip encoded` VLR says, as far as the checks need it.
+pub(super) struct LazLayout {
+    /// Points per chunk; `None` for variable-size chunks.
+    fixed_chunk_points: Option<u64>,
+}
+
+/// The `laszip encoded` VLR, checked before the `laz` crate uses it: present, a compressor
+/// the crate decodes (the chunked ones, LASzip 2.0 and later), items whose sizes add up to
+/// the header's point record length (the crate divides by that sum, and a zero sum panicked
+/// in its parallel decompressor), and a fixed chunk of points that needs at most 1 GiB of
+/// decompression buffer.
 pub(super) fn check_laszip_vlr(
     path: &Path,
     head: &FileHead,
     vlrs: &[las::raw::Vlr],
-) -> Result<(), LasError> {
-    if !head.compressed {
-        return Ok(());
-    }
-    let Some(vlr) = laszip_vlr(vlrs) else {
-        return Ok(()); // the `las` crate reports it missing
-    };
-    let Ok(laz_vlr) = laz::LazVlr::from_buffer(&vlr.data) else {
-        return Ok(()); // the `las` crate reports it unreadable
-    };
-    let bad = |what: String| LasError::Truncated {
+) -> Result<LazLayout, LasError> {
+    let corrupt = |what: String| LasError::Corrupt {
         path: path.to_path_buf(),
         what,
     };
+    let unsupported = |what: String| LasError::Unsupported {
+        path: path.to_path_buf(),
+        what,
+    };
+    let Some(vlr) = laszip_vlr(vlrs) else {
+        return Err(corrupt(
+            "the point format says LAZ but the header has no 'laszip encoded' VLR".into(),
+        ));
+    };
+    // The VLR's first field is the compressor type; the `laz` crate keeps it private and
+    // refuses type 1 only when decoding starts, after reading a chunk table that type 1
+    // files do not have.
+    match vlr.data.get(..2).map(|b| u16::from_le_bytes([b[0], b[1]])) {
+        Some(2 | 3) => {}
+        Some(1) => {
+            return Err(unsupported(
+                "LAZ pointwise compression (LASzip 1.x) is not supported; recompress with laszip or PDAL"
+                    .into(),
+            ))
+        }
+        Some(0) => {
+            return Err(corrupt(
+                "the 'laszip encoded' VLR names compressor 0 (no compression) in a LAZ file".into(),
+            ))
+        }
+        Some(t) => {
+            return Err(corrupt(format!(
+                "the 'laszip encoded' VLR names compressor type {t}, which LASzip does not define"
+            )))
+        }
+        None => return Err(corrupt("the 'laszip encoded' VLR is empty".into())),
+    }
+    let laz_vlr = laz::LazVlr::from_buffer(&vlr.data).map_err(|e| match e {
+        laz::LasZipError::UnsupportedLazItemVersion(item, version) => unsupported(format!(
+            "LAZ item {item:?} compressed with version {version} is not supported"
+        )),
+        laz::LasZipError::IoError(_) => {
+            corrupt("the 'laszip encoded' VLR ends before its item list does".into())
+        }
+        e => corrupt(format!(
+            "the 'laszip encoded' VLR cannot be read: {}",
+            laz_reason(&e)
+        )),
+    })?;
     let sizes: u64 = laz_vlr.items().iter().map(|it| u64::from(it.size())).sum();
     if sizes == 0 || sizes != u64::from(head.record_len) {
-        return Err(bad(format!(
+        return Err(corrupt(format!(
             "the LAZ items describe {sizes}-byte points but the header says {}-byte records",
             head.record_len
         )));
     }
-    let chunk_size = u64::from(laz_vlr.chunk_size());
-    if !laz_vlr.uses_variable_size_chunks() && chunk_size * sizes > MAX_CHUNK_BYTES {
-        return Err(bad(format!(
-            "the LAZ chunk size of {chunk_size} points of {sizes} bytes needs more than 1 GiB per chunk"
-        )));
+    let fixed_chunk_points =
+        (!laz_vlr.uses_variable_size_chunks()).then(|| u64::from(laz_vlr.chunk_size()));
+    if let Some(chunk) = fixed_chunk_points {
+        if chunk * sizes > MAX_CHUNK_BYTES {
+            return Err(unsupported(format!(
+                "LAZ chunks of {chunk} points of {sizes} bytes need more than 1 GiB each to decompress; recompress with smaller chunks (laszip -chunk_size)"
+            )));
+        }
     }
-    Ok(())
+    Ok(LazLayout { fixed_chunk_points })
 }
 
-/// LAZ: the chunk table's entry count, checked against the compressed bytes before the
-/// `laz` crate reserves a `Vec` of that many 16-byte entries (a 2^32-entry claim is a 60 GB
-/// allocation). Every chunk takes at least one byte between the point data start (plus its
+/// LAZ: the chunk table, checked before the `laz` crate reads it. The crate reserves a
+/// `Vec` of as many 16-byte entries as the table claims (a 2^32-entry claim is a 60 GB
+/// allocation); every chunk takes at least one byte between the point data start (plus its
 /// 8-byte table offset) and the table, so more entries than those bytes cannot be true.
+/// With fixed-size chunks the table must also hold the header's point count.
+///
 /// Locating the table mirrors `laz::laszip::ChunkTable::read_offset`: the offset at the
 /// start of the point data, or, when the writer could not update it, in the file's last 8
 /// bytes.
@@ -76,16 +123,14 @@ pub(super) fn check_laz_chunk_table(
     path: &Path,
     file: &mut File,
     head: &FileHead,
+    layout: &LazLayout,
 ) -> Result<(), LasError> {
-    if !head.compressed {
-        return Ok(());
-    }
     let file_size = head.file_size;
     let io = |source| LasError::Io {
         path: path.to_path_buf(),
         source,
     };
-    let bad = |what: String| LasError::Truncated {
+    let corrupt = |what: String| LasError::Corrupt {
         path: path.to_path_buf(),
         what,
     };
@@ -97,31 +142,85 @@ pub(super) fn check_laz_chunk_table(
         Ok(u64::from_le_bytes(b))
     };
     let data_start = u64::from(head.offset_to_point_data);
-    if data_start.saturating_add(8) > file_size || file_size < 16 {
-        // No room for the table offset: the `laz` crate reports the short read itself.
-        return Ok(());
+    if data_start.saturating_add(8) > file_size {
+        return Err(LasError::Truncated {
+            path: path.to_path_buf(),
+            what: format!(
+                "the file ends at byte {file_size}, before the LAZ chunk table offset at byte {data_start}"
+            ),
+        });
     }
     let mut table = read_u64_at(file, data_start)? as i64;
     if table <= data_start as i64 {
         table = read_u64_at(file, file_size - 8)? as i64;
         if table <= data_start as i64 {
-            return Ok(()); // no chunk table: `laz` reports it missing
+            return Err(corrupt(
+                "no LAZ chunk table: neither the start of the point data nor the end of the file gives its offset"
+                    .into(),
+            ));
         }
     }
     let table = table as u64;
     if table.saturating_add(8) > file_size {
-        return Err(bad(format!(
-            "the LAZ chunk table would start at byte {table}, past the end of the {file_size}-byte file"
-        )));
+        // Compressed points never take more room than uncompressed ones (plus the offset):
+        // a table beyond that is not where a cut file lost it.
+        let uncompressed_end = head
+            .count
+            .saturating_mul(u64::from(head.record_len))
+            .saturating_add(data_start + 8);
+        return Err(if table <= uncompressed_end {
+            LasError::Truncated {
+                path: path.to_path_buf(),
+                what: format!(
+                    "the file ends at byte {file_size}, before the LAZ chunk table at byte {table}"
+                ),
+            }
+        } else {
+            corrupt(format!(
+                "the LAZ chunk table offset (byte {table}) lies past the end of the {file_size}-byte file and past where even uncompressed points would end"
+            ))
+        });
     }
     let chunks = read_u64_at(file, table)? >> 32;
     let room = table.saturating_sub(data_start + 8);
     if chunks > room {
-        return Err(bad(format!(
+        return Err(corrupt(format!(
             "the LAZ chunk table claims {chunks} chunks but only {room} bytes of compressed points precede it"
         )));
     }
+    if let Some(per_chunk) = layout.fixed_chunk_points {
+        let holds = chunks.saturating_mul(per_chunk);
+        if holds < head.count {
+            return Err(corrupt(format!(
+                "the header says {} points but the LAZ chunk table's {chunks} chunks of {per_chunk} points hold at most {holds}",
+                head.count
+            )));
+        }
+    }
     Ok(())
+}
+
+/// A `laz` crate error as a sentence without the crate's type names.
+pub(super) fn laz_reason(e: &laz::LasZipError) -> String {
+    use laz::LasZipError as E;
+    match e {
+        E::UnknownLazItem(t) => format!("an item of unknown type {t}"),
+        E::UnsupportedLazItemVersion(item, v) => {
+            format!("item {item:?} compressed with version {v}, which is not supported")
+        }
+        E::UnknownCompressorType(t) => format!("unknown compressor type {t}"),
+        E::UnsupportedCompressorType(c) => format!("compressor {c:?} is not supported"),
+        E::UnsupportedPointFormat(f) => format!("point format {f} is not supported by LAZ"),
+        E::MissingChunkTable => "the chunk table is missing".into(),
+        E::IoError(io) if io.to_string().contains("no chunks available") => {
+            "the chunk table lists fewer points than the header".into()
+        }
+        E::IoError(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
+            "the compressed data ends before the points it should hold".into()
+        }
+        E::IoError(io) => io.to_string(),
+        e => e.to_string(),
+    }
 }
 
 #[cfg(test)]

@@ -33,6 +33,7 @@ mod sort;
 mod vlrs;
 
 pub use columns::PointColumns;
+pub use crs::NoCrs;
 pub use decode::CHUNK_POINTS;
 pub use error::LasError;
 pub use header::format_has_gps_time;
@@ -74,10 +75,38 @@ pub struct LasInfo {
     pub selection: ScannerSelection,
     /// The file's CRS: EPSG from the GeoTIFF keys, or the WKT VLR; `None` when absent.
     pub crs: Option<Crs>,
+    /// Why `crs` is `None`.
+    pub no_crs: Option<NoCrs>,
     /// Whether the points had to be reordered by time.
     pub was_reordered: bool,
     /// Whether the scan angle column carries information (not all one value).
     pub has_scan_angle: bool,
+}
+
+/// A file whose header, VLRs and (LAZ) chunk table passed every check: the points can be
+/// decoded.
+struct CheckedFile {
+    head: header::FileHead,
+    /// Points the columns may reserve before decoding.
+    reserve: u64,
+}
+
+/// Checks a file in the order a reader wants the reason: signature, version, point format
+/// and what it lacks, the header's consistency (with the file's size, its VLRs and extended
+/// VLRs), then the compression details. Nothing is allocated from a header field before it
+/// is checked.
+fn check_file(path: &Path, file: &mut File, file_size: u64) -> Result<CheckedFile, LasError> {
+    let head = header::read_head(path, file, file_size)?;
+    header::check_format(path, &head)?;
+    header::check_consistency(path, &head)?;
+    let reserve = header::check_point_data_bounds(path, &head)?;
+    let vlr_list = vlrs::read_vlrs(path, file, &head)?;
+    vlrs::check_evlrs(path, file, &head)?;
+    if head.compressed {
+        let layout = laz::check_laszip_vlr(path, &head, &vlr_list)?;
+        laz::check_laz_chunk_table(path, file, &head, &layout)?;
+    }
+    Ok(CheckedFile { head, reserve })
 }
 
 /// Reads the selected points of a LAS/LAZ file as columns sorted by time.
@@ -94,23 +123,17 @@ pub fn read_points(
     };
     let mut file = File::open(path).map_err(io)?;
     let file_size = file.metadata().map_err(io)?.len();
-    let head = header::read_head(path, &mut file, file_size)?;
-    vlrs::check_evlrs(path, &mut file, &head)?;
-    let vlr_list = vlrs::read_vlrs(path, &mut file, &head)?;
-    laz::check_laszip_vlr(path, &head, &vlr_list)?;
-    laz::check_laz_chunk_table(path, &mut file, &head)?;
-    if !format_has_gps_time(head.format) {
-        return Err(LasError::NoGpsTime {
-            path: path.to_path_buf(),
-            format: head.format,
-        });
-    }
-    let reserve = header::check_point_data_bounds(path, &head)?;
+    let checked = check_file(path, &mut file, file_size)?;
     drop(file);
 
-    let mut reader = decode::open_reader(path)?;
-    let crs = crs::header_crs(reader.header());
+    let mut reader = decode::open_reader(path, &checked.head)?;
+    let (crs, no_crs) = match crs::header_crs(reader.header()) {
+        Ok(crs) => (Some(crs), None),
+        Err(why) => (None, Some(why)),
+    };
+    let head = checked.head;
     let extended = reader.header().point_format().is_extended;
+    let reserve = checked.reserve;
     let mut cols = PointColumns::with_capacity(usize::try_from(reserve).unwrap_or(0));
     let mut selector = scanner::Selector::new(opts.scanner, extended);
     let total =
@@ -132,6 +155,7 @@ pub fn read_points(
         points_selected: cols.len() as u64,
         selection,
         crs,
+        no_crs,
         was_reordered,
         has_scan_angle,
     };
@@ -211,7 +235,7 @@ pub(crate) mod tests {
         (path, pts)
     }
 
-    /// Regression (fuzz target `host_inputs`, session 2): LAZ items whose sizes add up to 0
+    /// Regression (fuzz target `host_inputs`): LAZ items whose sizes add up to 0
     /// made the `laz` crate's parallel decompressor divide by zero.
     #[test]
     fn laz_items_that_do_not_describe_the_point_record_are_an_error() {
@@ -244,7 +268,7 @@ pub(crate) mod tests {
         assert_eq!(read(&path, None).unwrap().0.t.len(), 10);
     }
 
-    /// Regression (fuzz target `host_inputs`, session 2): a LAS 1.4 header whose legacy and
+    /// Regression (fuzz target `host_inputs`): a LAS 1.4 header whose legacy and
     /// 64-bit point counts disagree was size-checked with one and decoded with the other.
     #[test]
     fn disagreeing_point_counts_are_an_error() {
@@ -265,7 +289,7 @@ pub(crate) mod tests {
         assert_eq!(read(&path, None).unwrap().0.t.len(), 10);
     }
 
-    /// Regression (fuzz target `host_inputs`, session 2): a LAZ chunk table claiming 2^32
+    /// Regression (fuzz target `host_inputs`): a LAZ chunk table claiming 2^32
     /// chunks made the `laz` crate reserve 60 GB before decoding a single entry.
     #[test]
     fn a_laz_chunk_table_claiming_more_chunks_than_bytes_is_an_error_before_any_allocation() {

@@ -19,8 +19,10 @@ mod evlr_field {
     pub const RECORD_LEN: std::ops::Range<usize> = 20..28;
 }
 
-/// Reads the header's VLRs, in file order, as far as they lie before the point data (a VLR
-/// that would reach into the point data ends the list; the `las` crate reports it).
+/// Reads the header's VLRs, in file order. Each must lie between the header and the point
+/// data: one that reaches into the point data means the VLR count or a record length is
+/// wrong (the file is corrupt, not short: the point data offset was checked against the
+/// file's size before).
 pub(super) fn read_vlrs(
     path: &Path,
     file: &mut File,
@@ -30,22 +32,32 @@ pub(super) fn read_vlrs(
         path: path.to_path_buf(),
         source,
     };
-    let end = u64::from(head.offset_to_point_data).min(head.file_size);
+    let end = u64::from(head.offset_to_point_data);
+    let count = head.vlr_count;
+    let corrupt = |i: u32, pos: u64| {
+        LasError::Corrupt {
+        path: path.to_path_buf(),
+        what: format!(
+            "the header counts {count} VLRs but VLR {i} at byte {pos} reaches past the start of the point data at byte {end}"
+        ),
+    }
+    };
     let mut pos = u64::from(head.header_size);
     file.seek(SeekFrom::Start(pos)).map_err(io)?;
     let mut read = BufReader::new(&mut *file);
     let mut vlrs = Vec::new();
-    for _ in 0..head.vlr_count {
+    for i in 0..count {
         if pos + VLR_HEADER_LEN > end {
-            break;
+            return Err(corrupt(i, pos));
         }
-        let Ok(vlr) = las::raw::Vlr::read_from(&mut read, false) else {
-            break;
-        };
-        pos += VLR_HEADER_LEN + u64::from(vlr.record_length_after_header);
-        if pos > end {
-            break;
+        // A record is at most 65 535 bytes; one that the file cannot hold reaches past the
+        // point data too.
+        let vlr = las::raw::Vlr::read_from(&mut read, false).map_err(|_| corrupt(i, pos))?;
+        let vlr_end = pos + VLR_HEADER_LEN + u64::from(vlr.record_length_after_header);
+        if vlr_end > end {
+            return Err(corrupt(i, pos));
         }
+        pos = vlr_end;
         vlrs.push(vlr);
     }
     Ok(vlrs)
