@@ -225,7 +225,7 @@ pub(super) fn check_consistency(path: &Path, head: &FileHead) -> Result<(), LasE
 /// Where the point records lie against the file's size: the point data inside the file, at
 /// least one point and at most [`MAX_POINTS`](super::MAX_POINTS), and (uncompressed) every
 /// record the header counts inside the file.
-/// Returns how many points may be reserved before decoding.
+/// Returns the number of bytes of point data (compressed for LAZ).
 pub(super) fn check_point_data_bounds(path: &Path, head: &FileHead) -> Result<u64, LasError> {
     let file_size = head.file_size;
     if u64::from(head.offset_to_point_data) > file_size {
@@ -244,9 +244,7 @@ pub(super) fn check_point_data_bounds(path: &Path, head: &FileHead) -> Result<u6
         });
     }
     let point_bytes = file_size - u64::from(head.offset_to_point_data);
-    let reserve = if head.compressed {
-        super::laz::laz_reserve_cap(head.count, point_bytes)
-    } else {
+    if !head.compressed {
         let need = head.count.saturating_mul(u64::from(head.record_len));
         if need > point_bytes {
             return Err(LasError::SizeMismatch {
@@ -258,8 +256,7 @@ pub(super) fn check_point_data_bounds(path: &Path, head: &FileHead) -> Result<u6
                 size: file_size,
             });
         }
-        head.count
-    };
+    }
     if head.count > super::MAX_POINTS {
         return Err(LasError::TooMany {
             path: path.to_path_buf(),
@@ -267,5 +264,5 @@ pub(super) fn check_point_data_bounds(path: &Path, head: &FileHead) -> Result<u6
             max: super::MAX_POINTS,
         });
     }
-    Ok(reserve)
+    Ok(point_bytes)
 }

@@ -99,7 +99,12 @@ fn check_file(path: &Path, file: &mut File, file_size: u64) -> Result<CheckedFil
     let head = header::read_head(path, file, file_size)?;
     header::check_format(path, &head)?;
     header::check_consistency(path, &head)?;
-    let reserve = header::check_point_data_bounds(path, &head)?;
+    let point_bytes = header::check_point_data_bounds(path, &head)?;
+    let reserve = if head.compressed {
+        laz::laz_reserve_cap(head.count, point_bytes)
+    } else {
+        head.count
+    };
     let vlr_list = vlrs::read_vlrs(path, file, &head)?;
     vlrs::check_evlrs(path, file, &head)?;
     if head.compressed {
