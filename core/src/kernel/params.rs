@@ -22,9 +22,7 @@
 //! little-endian bytes, so the same words always give the same hash on every platform.
 
 use crate::scanline::assemble::{GeometrySplit, SplitParams};
-
-/// Number of 32-bit words of the config packet's parameter block.
-pub const CONFIG_WORDS: usize = 16;
+use crate::wire::CONFIG_WORDS;
 
 /// Why a config block was rejected.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

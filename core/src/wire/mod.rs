@@ -48,7 +48,6 @@ mod output;
 mod points;
 mod scan;
 
-pub use crate::kernel::CONFIG_WORDS;
 pub use encoder::StreamEncoder;
 pub use output::{
     OutputColumns, OutputHeaderRepr, OutputPointRepr, OutputPoints, OUTPUT_HEADER_LEN,
@@ -80,6 +79,9 @@ pub const MAX_POINTS_PER_PACKET: usize = 64;
 /// The largest number of output points in one output packet (1464 bytes).
 pub const MAX_OUTPUT_POINTS_PER_PACKET: usize =
     (MAX_PACKET_LEN - HEADER_LEN - OUTPUT_HEADER_LEN - CRC_LEN) / OUTPUT_POINT_LEN;
+/// Number of 32-bit words in a config packet's payload. The wire layer carries them
+/// opaquely; `kernel::KernelParams` converts parameters to and from them.
+pub const CONFIG_WORDS: usize = 16;
 /// Length of a config packet (fixed).
 pub const CONFIG_PACKET_LEN: usize = HEADER_LEN + 4 * CONFIG_WORDS + CRC_LEN;
 
@@ -504,7 +506,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ConfigRepr {
-    /// Opaque to the wire layer; [`crate::kernel::KernelParams`] gives them meaning.
+    /// Opaque to the wire layer; `kernel::KernelParams` gives them meaning.
     pub words: [u32; CONFIG_WORDS],
 }
 

@@ -258,7 +258,7 @@ mod tests {
         let mut enc = StreamEncoder::new();
         let mut buf = [0u8; 200];
         let n = enc
-            .encode_config(&[5; crate::kernel::CONFIG_WORDS], &mut buf)
+            .encode_config(&[5; crate::wire::CONFIG_WORDS], &mut buf)
             .unwrap();
         for cut in 0..=n {
             let (a, b) = buf[..n].split_at(cut);
