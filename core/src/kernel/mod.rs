@@ -37,10 +37,10 @@ mod seed;
 mod smooth;
 #[cfg(test)]
 mod synth;
-pub use params::{KernelParams, ParamsError};
 /// The config packet's word count, defined by the wire format and re-exported beside the
 /// parameters that fill it.
 pub use crate::wire::CONFIG_WORDS;
+pub use params::{KernelParams, Param, ParamsError};
 
 /// What happened to one input point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
