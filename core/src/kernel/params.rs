@@ -157,15 +157,25 @@ impl core::fmt::Display for ParamsError {
 
 impl core::error::Error for ParamsError {}
 
-/// Every parameter of the kernel (Honma et al. §2.3–2.6) and of scanline assembly (SPEC §2,
-/// *Scanline*), so that one config packet configures the whole core.
+/// Every parameter of the kernel (Honma et al. §2.3–2.6) and of scanline assembly
+/// (docs/spec.md §2, *Scanline*), so that one config packet configures the whole core.
 ///
 /// The paper gives the Taubin values (§2.5) and nothing else numerically; every other
-/// default below says how it was chosen. The target is a VQ-250-class line (SPEC, paper
+/// default below says how it was chosen. The target is a VQ-250-class line (Honma et al.
 /// Table 1): about 10 mm point spacing on the road near the scanner, about 35 mm at 5 m,
 /// up to about 140 mm at the far curb; curbs 80–200 mm high; curb cuts 20–30 mm steps.
+///
+/// With the `serde` feature it (de)serialises as a table of its fields under their own
+/// names; missing fields take their defaults and unknown ones are rejected, so a typo does
+/// not silently leave a default in force. Deserialising does not check ranges: call
+/// [`Self::validate`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct KernelParams {
     /// d_b: neighbour distance for the bend angle, metres (§2.3: s and t are the farthest
     /// points within d_b of p_i, walking outward along the scanline).
@@ -174,13 +184,13 @@ pub struct KernelParams {
     /// lowest common curbs (80 mm): with d_b < h the toe of a step is a sharp +90° peak (s on
     /// the road, t on the face), while with d_b > h the far neighbour lands on the curb top
     /// for every road point within √(d_b² − h²) of the toe and ρ forms a plateau of
-    /// asin(h/d_b) there, which lets noise place the peak anywhere on it. Measured on the
-    /// synthetic scanline (`kernel::tests`, 5 mm noise, 80 runs): 80 mm curbs give a worst
-    /// candidate 20 mm from the toe with 0.07 m against 61 mm with 0.10 m and 97 mm with
-    /// 0.13 m; 150 mm curbs are the same for all three (≤ 19 mm). 0.07 m still spans 7
-    /// points at 10 mm spacing and 2 at 35 mm (5 m out), enough to average the noise. At
-    /// the far curb (≈140 mm spacing) road points have no neighbour within d_b and get
-    /// [`super::PointStatus::NoNeighbour`]; the host's tracking (§2.7) covers that side.
+    /// asin(h/d_b) there, which lets noise place the peak anywhere on it. On the synthetic
+    /// scanline of `kernel::tests` (5 mm noise), 0.07 m puts the candidates of 80 mm curbs
+    /// nearer the toe than 0.10 m or 0.13 m do; on 150 mm curbs the three agree. 0.07 m
+    /// still spans 7 points at 10 mm spacing and 2 at 35 mm (5 m out), enough to average
+    /// the noise. At the far curb (≈140 mm spacing) road points have no neighbour within
+    /// d_b and get [`super::PointStatus::NoNeighbour`]; the host's tracking (§2.7) covers
+    /// that side.
     pub d_b_m: f32,
     /// Threshold for the removal of irregular points, degrees (§2.4: points with |ρ| above
     /// it on the raw line are removed before smoothing).
@@ -197,9 +207,9 @@ pub struct KernelParams {
     /// Default 35° — not given by the paper ("close to 90 degrees"). Far below the toe of
     /// any curb taller than d_b (≈90°, somewhat less after smoothing rounds the corner) and
     /// below a 40 mm step's asin(0.04/0.07) ≈ 35°, yet well above road crown, ruts and the
-    /// 5 mm noise left after smoothing (a few degrees; no false candidate in the 80
-    /// synthetic runs). Curb cuts (20–30 mm steps, ρ ≈ 17–25°) give no peak; the host
-    /// tracks through them (§2.7).
+    /// 5 mm noise left after smoothing (a few degrees; the synthetic lines of
+    /// `kernel::tests` give no false candidate). Curb cuts (20–30 mm steps, ρ ≈ 17–25°)
+    /// give no peak; the host tracks through them (§2.7).
     pub tau_min_deg: f32,
     /// τ_ρmax: upper bound (exclusive) of the bend angle of a peak, degrees (§2.6).
     ///
@@ -223,7 +233,7 @@ pub struct KernelParams {
     /// bends; fixing both sides of a gap keeps the paper's "ends fixed" per visible piece.
     /// 0.30 m is twice the largest spacing expected on the road (≈140 mm at the far curb).
     pub smooth_gap_m: f32,
-    /// Assembly (`scanline::assemble`, SPEC §2 *Scanline*): a time step between
+    /// Assembly (`scanline::assemble`, docs/spec.md §2 *Scanline*): a time step between
     /// consecutive points longer than this ends the line, nanoseconds.
     ///
     /// Default 5 ms — the assembler's own default ([`SplitParams::DEFAULT`]): half a
