@@ -87,8 +87,7 @@ pub(crate) fn copy_from_two(a: &[u8], b: &[u8], start: usize, dst: &mut [u8]) ->
 
 /// CRC-32 of bytes `0..end` of `a ++ b` (caller guarantees `end ≤ a.len() + b.len()`).
 /// Out of line: inlined into the ingest loop, the CRC's table bases and the loop's own
-/// registers competed and both spilled (measured on the M4F: +14 instructions per point
-/// for the CRC, +32 for the rest of ingest).
+/// registers compete and both spill on the M4F.
 #[inline(never)]
 fn crc_two(a: &[u8], b: &[u8], end: usize) -> u32 {
     let mut c = Crc32::new();
