@@ -140,7 +140,9 @@ mod tests {
         std::fs::write(&p, "[kernel]\ntau_max_deg = 30.0\n").unwrap();
         let e = Config::read(&p).unwrap_err().to_string();
         assert!(
-            e.ends_with("k.toml: [kernel]: tau_max_deg = 30 is outside its range (tau_min_deg, 180]"),
+            e.ends_with(
+                "k.toml: [kernel]: tau_max_deg = 30 is outside its range (tau_min_deg, 180]"
+            ),
             "{e}"
         );
         std::fs::write(&p, "[kernel]\ntau_mx_deg = 30.0\n").unwrap();
