@@ -4,6 +4,8 @@
 //! line); every fragment repeats the line header, so each packet is self-describing and a
 //! lost fragment loses only its own points.
 //!
+//! [`MAX_OUTPUT_POINTS_PER_PACKET`]: super::MAX_OUTPUT_POINTS_PER_PACKET
+//!
 //! Values are scaled integers: x′/z′ in micrometres (`i32`, ±2147 m — at a scanner's
 //! ranges an `f32` itself resolves about 1–8 µm), ρ in centidegrees (`i16`,
 //! −17 999..=18 000 for (−180°, 180°]).
