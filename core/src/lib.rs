@@ -17,12 +17,22 @@
 //!
 //! Every buffer is bounded by a const generic; every byte and every point that enters is
 //! accounted for in counters.
+//!
+//! # Features
+//!
+//! - `libm` (default) — bit-exact maths, the same output bytes on every platform.
+//! - `micromath` — fast approximate maths. **If it is on, it is the backend**, also when
+//!   `libm` is on too (as with `--features micromath` and the default features); libm is
+//!   then compiled only for the tests that compare the two. [`math::BACKEND`] says which
+//!   backend a build uses; [`math`] explains the rule.
+//! - `serde` — `Serialize`/`Deserialize` for [`kernel::KernelParams`] (no alloc).
+//! - `defmt` — `defmt::Format` for logging on target.
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
 pub mod kernel;
-pub(crate) mod math;
+pub mod math;
 pub mod pipeline;
 pub mod scanline;
 pub mod wire;

@@ -1,31 +1,75 @@
-//! The one door to float maths (STYLE.md): call `math::atan2(y, x)`, never methods, so the
-//! host build and the target build use the same backend. With `std` linked into host tests,
-//! `x.atan2(y)` would silently call std's maths while the target uses micromath, and the two
-//! builds would disagree.
+//! The maths backend, and the one door to float maths: the kernel calls
+//! `math::atan2(y, x)`, never methods such as `y.atan2(x)`, so the host build and the
+//! target build use the same backend. (With `std` linked into host tests, method syntax
+//! would silently call std's maths while the target uses micromath, and the two builds
+//! would disagree.)
 //!
-//! Backends, chosen by feature:
+//! # Backends
 //!
 //! | feature | atan2 | sin / cos | bits |
 //! |---|---|---|---|
-//! | `libm` (default) | ≤ 2 ulp ([`atan2_octant`]) | ≤ 1 ulp | identical on x86-64 and Cortex-M4F |
-//! | `micromath` | max error 0.162° (TOOLCHAIN.md, 1e6 samples) | about 1.1e-3 | approximate |
+//! | `libm` (default) | ≤ 2 ulp (`atan2_octant`) | ≤ 1 ulp | identical on x86-64 and Cortex-M4F |
+//! | `micromath` | within about 0.16° | about 1.1e-3 | approximate |
 //!
-//! When both features are enabled (`--features micromath` keeps the default `libm`),
-//! **micromath wins**: asking for it is an explicit choice, the default is not. With
-//! neither, the crate does not compile.
+//! # Which backend runs
 //!
-//! The kernel's hot path uses only [`atan2`] (once per kept point, for the output ρ);
+//! **The `micromath` feature selects micromath; without it, libm runs.** [`BACKEND`] says
+//! which, for programs to print (`curbtrace kernel` does).
+//!
+//! Cargo features are additive and `libm` is a default feature, so `--features micromath`
+//! alone builds both backends. That build is not an error, because it is the one the tests
+//! need: with both compiled in, the micromath tolerance test runs the same lines through
+//! both and compares them, while everything else (the kernel, the other tests) uses
+//! micromath. A product build that wants micromath says
+//! `--no-default-features --features micromath` (the firmware's micromath build does), and
+//! libm is then not compiled at all. With neither feature the crate does not compile.
+//!
+//! The kernel's hot path uses only `atan2` (once per kept point, for the output ρ);
 //! thresholds are compared without it (see `kernel::bend`).
+
+/// A maths backend of the core (see the module docs for the rule that picks one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Backend {
+    /// `libm`: bit-exact, portable; the same output bytes on every platform.
+    Libm,
+    /// `micromath`: fast, approximate.
+    Micromath,
+}
+
+impl Backend {
+    /// The backend's name, as its Cargo feature spells it.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Backend::Libm => "libm",
+            Backend::Micromath => "micromath",
+        }
+    }
+}
+
+impl core::fmt::Display for Backend {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The backend this build of the core computes with: micromath when its feature is on,
+/// otherwise libm.
+pub const BACKEND: Backend = if cfg!(feature = "micromath") {
+    Backend::Micromath
+} else {
+    Backend::Libm
+};
 
 #[cfg(not(any(feature = "libm", feature = "micromath")))]
 compile_error!(
     "curbtrace-core needs a maths backend: enable feature `libm` (the default) or `micromath`"
 );
 
-/// A float backend. The kernel is generic over it only so that a test build with both
-/// features can run the same line through both (the micromath tolerance test); everything
-/// else calls the free functions below.
-pub(crate) trait Backend {
+/// The functions of a backend. The kernel is generic over it only so that a test build with
+/// both features can run the same line through both (the micromath tolerance test);
+/// everything else calls the free functions below.
+pub(crate) trait Maths {
     /// Four-quadrant arctangent of `y / x`, radians in [−π, π]; +0 for x = y = ±0 (the
     /// bend angle relies on it).
     fn atan2(y: f32, x: f32) -> f32;
@@ -41,7 +85,7 @@ pub(crate) trait Backend {
 pub(crate) struct Libm;
 
 #[cfg(feature = "libm")]
-impl Backend for Libm {
+impl Maths for Libm {
     #[inline]
     fn atan2(y: f32, x: f32) -> f32 {
         atan2_octant(y, x)
@@ -63,7 +107,7 @@ impl Backend for Libm {
 /// (finite: the kernel sets non-finite and out-of-range points aside first): atan2f's
 /// special-case tests for NaN, infinities, zeros and extreme ratios go (x = y = 0 is one
 /// test here, and gives +0, which the bend angle relies on), and atanf always gets an
-/// argument ≤ 1, its short path (no reciprocal). On the Cortex-M4F it saved 13
+/// argument ≤ 1, its short path (no reciprocal); on the Cortex-M4F that is fewer
 /// instructions per input point (docs/benchmarks.md). Every step is an IEEE-754 f32
 /// operation or `libm::atanf`, so the host and the M4F agree bit for bit. Accuracy: atanf's
 /// 1 ulp plus one rounded subtraction — within 2 ulp of the true angle (tested against f64
@@ -98,7 +142,7 @@ pub(crate) fn atan2_octant(y: f32, x: f32) -> f32 {
 pub(crate) struct Micromath;
 
 #[cfg(feature = "micromath")]
-impl Backend for Micromath {
+impl Maths for Micromath {
     #[inline]
     fn atan2(y: f32, x: f32) -> f32 {
         // micromath divides by x² + |bxy| + n, which is 0 at the origin; libm gives 0 there.
@@ -117,16 +161,16 @@ impl Backend for Micromath {
     }
 }
 
-/// The backend in force (micromath when both features are on; see the module docs).
+/// The backend in force ([`BACKEND`]; micromath when both features are on).
 #[cfg(feature = "micromath")]
 pub(crate) type Selected = Micromath;
-/// The backend in force (micromath when both features are on; see the module docs).
+/// The backend in force ([`BACKEND`]).
 #[cfg(all(feature = "libm", not(feature = "micromath")))]
 pub(crate) type Selected = Libm;
 
 /// Four-quadrant arctangent of `y / x`, radians.
 #[inline]
-#[allow(dead_code)] // the kernel calls it through `Backend`; kept as the documented door
+#[allow(dead_code)] // the kernel calls it through `Maths`; kept as the documented door
 pub(crate) fn atan2(y: f32, x: f32) -> f32 {
     Selected::atan2(y, x)
 }
@@ -212,6 +256,39 @@ mod tests {
             atan2_octant(-1.0, -1.0),
             -3.0 * core::f32::consts::FRAC_PI_4
         );
+    }
+
+    /// [`BACKEND`] names the backend the free functions use.
+    #[test]
+    fn backend_constant_names_the_backend_in_force() {
+        extern crate std;
+        use std::string::ToString;
+        let probe = [(0.3f32, 0.7f32), (1.0, 1.0), (-2.0, 0.5)];
+        for (y, x) in probe {
+            let got = atan2(y, x).to_bits();
+            match BACKEND {
+                #[cfg(feature = "libm")]
+                Backend::Libm => assert_eq!(got, Libm::atan2(y, x).to_bits()),
+                #[cfg(feature = "micromath")]
+                Backend::Micromath => assert_eq!(got, Micromath::atan2(y, x).to_bits()),
+                #[allow(unreachable_patterns)]
+                other => panic!("{other} is not compiled into this build"),
+            }
+        }
+        // With both compiled in, the probe tells them apart, so the match above is a test.
+        #[cfg(all(feature = "libm", feature = "micromath"))]
+        assert!(probe
+            .iter()
+            .any(|&(y, x)| Libm::atan2(y, x) != Micromath::atan2(y, x)));
+        assert_eq!(
+            BACKEND,
+            if cfg!(feature = "micromath") {
+                Backend::Micromath
+            } else {
+                Backend::Libm
+            }
+        );
+        assert_eq!(BACKEND.to_string(), BACKEND.name());
     }
 
     #[cfg(all(feature = "libm", not(feature = "micromath")))]

@@ -430,7 +430,10 @@ mod tests {
         assert_eq!(c.configs_rejected, 1);
         assert_eq!(
             c.last_config_error,
-            Some(ParamsError::OutOfRange { index: 0 })
+            Some(ParamsError::OutOfRange {
+                param: crate::kernel::Param::DBM,
+                word: f32::NAN.to_bits()
+            })
         );
         assert_eq!(p.params().d_b_m, 0.05);
     }

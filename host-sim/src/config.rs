@@ -13,7 +13,7 @@
 
 use crate::bend::BendParams;
 use crate::replay::run::ReplayParams;
-use curbtrace_core::kernel::{KernelParams, CONFIG_WORDS};
+use curbtrace_core::kernel::{KernelParams, ParamsError, CONFIG_WORDS};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -41,8 +41,8 @@ pub enum ConfigError {
     Kernel {
         /// The file.
         path: PathBuf,
-        /// Which parameter.
-        what: String,
+        /// Which parameter, its value and its range.
+        what: ParamsError,
     },
 }
 
@@ -50,8 +50,10 @@ pub enum ConfigError {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Config {
-    /// The core's parameters (`[kernel]`).
-    pub kernel: KernelConfig,
+    /// The core's parameters (`[kernel]`): the core's own struct, with its `serde` feature
+    /// (field names are the keys; each field's meaning and default are documented there).
+    /// The values go to the core in the stream's config packet.
+    pub kernel: KernelParams,
     /// Replay parameters (`[replay]`).
     pub replay: ReplayParams,
     /// The bend method's seeding, tracking and post-filters (`[bend]`).
@@ -88,81 +90,10 @@ impl Config {
     }
 
     /// The kernel's config words for the stream's config packet, checked by the core's own
-    /// `KernelParams::from_words`.
-    pub fn kernel_words(&self) -> Result<[u32; CONFIG_WORDS], String> {
-        let p = self.kernel.to_params();
-        let words = p.to_words();
-        KernelParams::from_words(&words).map_err(|e| format!("{e:?}"))?;
-        Ok(words)
-    }
-}
-
-/// The `[kernel]` table: a serde mirror of `curbtrace_core::kernel::KernelParams` (the core
-/// is `no_std` without serde); each field's meaning and default are documented there.
-/// Defaults are the core's `KernelParams::DEFAULT`; the values go to the core in the
-/// stream's config packet and are checked by the core itself.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct KernelConfig {
-    /// d_b: neighbour distance of the bend angle, metres (§2.3).
-    pub d_b_m: f32,
-    /// Irregular-point threshold on |ρ| of the raw line, degrees (§2.4).
-    pub irregular_deg: f32,
-    /// τ_min: lower bound of a peak's ρ, degrees (§2.6).
-    pub tau_min_deg: f32,
-    /// τ_max: upper bound of a peak's ρ, degrees (§2.6).
-    pub tau_max_deg: f32,
-    /// Taubin smoothing steps (§2.5).
-    pub taubin_steps: u32,
-    /// Taubin λ (§2.5).
-    pub taubin_lambda: f32,
-    /// Taubin μ (§2.5).
-    pub taubin_mu: f32,
-    /// Gap that splits a line into separately smoothed pieces, metres (0 = never).
-    pub smooth_gap_m: f32,
-    /// Assembly: pause that ends a line without flags, ns (0 = off).
-    pub split_gap_ns: u32,
-    /// Assembly: when the geometric split rule is active (0 = auto, 1 = always, 2 = never).
-    pub split_geometry: u32,
-}
-
-impl Default for KernelConfig {
-    fn default() -> Self {
-        Self::from_params(&KernelParams::DEFAULT)
-    }
-}
-
-impl KernelConfig {
-    /// From the core's struct.
-    pub fn from_params(p: &KernelParams) -> Self {
-        Self {
-            d_b_m: p.d_b_m,
-            irregular_deg: p.irregular_deg,
-            tau_min_deg: p.tau_min_deg,
-            tau_max_deg: p.tau_max_deg,
-            taubin_steps: p.taubin_steps,
-            taubin_lambda: p.taubin_lambda,
-            taubin_mu: p.taubin_mu,
-            smooth_gap_m: p.smooth_gap_m,
-            split_gap_ns: p.split_gap_ns,
-            split_geometry: p.split_geometry,
-        }
-    }
-
-    /// To the core's struct.
-    pub fn to_params(&self) -> KernelParams {
-        KernelParams {
-            d_b_m: self.d_b_m,
-            irregular_deg: self.irregular_deg,
-            tau_min_deg: self.tau_min_deg,
-            tau_max_deg: self.tau_max_deg,
-            taubin_steps: self.taubin_steps,
-            taubin_lambda: self.taubin_lambda,
-            taubin_mu: self.taubin_mu,
-            smooth_gap_m: self.smooth_gap_m,
-            split_gap_ns: self.split_gap_ns,
-            split_geometry: self.split_geometry,
-        }
+    /// `KernelParams::validate` (the check of `KernelParams::from_words`).
+    pub fn kernel_words(&self) -> Result<[u32; CONFIG_WORDS], ParamsError> {
+        self.kernel.validate()?;
+        Ok(self.kernel.to_words())
     }
 }
 
@@ -188,12 +119,34 @@ mod tests {
         std::fs::write(&p, "[replay]\nchunk_points = 1000\n").unwrap();
         let c = Config::read(&p).unwrap();
         assert_eq!(c.replay.chunk_points, 1000);
-        assert_eq!(c.kernel, KernelConfig::default());
+        assert_eq!(c.kernel, KernelParams::DEFAULT);
         std::fs::write(&p, "[replay]\nchunk_pionts = 1000\n").unwrap();
         let e = Config::read(&p).unwrap_err().to_string();
         assert!(
             e.contains("c.toml") && e.contains("chunk_pionts") && !e.contains('\n'),
             "{e}"
         );
+    }
+
+    #[test]
+    fn kernel_keys_and_range_errors_name_the_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("k.toml");
+        std::fs::write(&p, "[kernel]\ntau_max_deg = 170.0\ntaubin_steps = 10\n").unwrap();
+        let c = Config::read(&p).unwrap();
+        assert_eq!(c.kernel.tau_max_deg, 170.0);
+        assert_eq!(c.kernel.taubin_steps, 10);
+        assert_eq!(c.kernel.d_b_m, KernelParams::DEFAULT.d_b_m);
+        std::fs::write(&p, "[kernel]\ntau_max_deg = 30.0\n").unwrap();
+        let e = Config::read(&p).unwrap_err().to_string();
+        assert!(
+            e.ends_with(
+                "k.toml: [kernel]: tau_max_deg = 30 is outside its range (tau_min_deg, 180]"
+            ),
+            "{e}"
+        );
+        std::fs::write(&p, "[kernel]\ntau_mx_deg = 30.0\n").unwrap();
+        let e = Config::read(&p).unwrap_err().to_string();
+        assert!(e.contains("k.toml") && e.contains("tau_mx_deg"), "{e}");
     }
 }

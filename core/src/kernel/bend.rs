@@ -1,8 +1,8 @@
-//! Bend angle ρ (Honma et al. §2.3, SPEC §2) and the removal of irregular points (§2.4).
+//! Bend angle ρ (Honma et al. §2.3, docs/spec.md §2) and the removal of irregular points (§2.4).
 //!
 //! # Neighbours: one two-index sweep per side
 //!
-//! SPEC §2: walk outward from i while points stay within d_b of p_i; s and t are the last
+//! docs/spec.md §2: walk outward from i while points stay within d_b of p_i; s and t are the last
 //! points reached. The kernel finds them with monotone pointers, O(n) per line:
 //!
 //! - left, a forward sweep: s(i) is the first index j ≥ max(s(i−1), i − [`MAX_SIDE`]) with
@@ -11,16 +11,16 @@
 //!   j ≤ min(t(i+1), i + [`MAX_SIDE`]) with |p_j − p_i| ≤ d_b.
 //!
 //! Wherever the distance from p_i grows along the line away from i (a profile that does not
-//! fold back on itself within d_b) this is exactly the SPEC walk; where noise folds the line
-//! back (a return nearer to p_i than its predecessor), the sweep may reach one point past
-//! the excursion. The two rules are mirror images, so reversing the line (the other
+//! fold back on itself within d_b) this is exactly the walk of docs/spec.md §2; where noise
+//! folds the line back (a return nearer to p_i than its predecessor), the sweep may reach
+//! one point past the excursion. The two rules are mirror images, so reversing the line (the other
 //! rotation direction) swaps s and t exactly. [`MAX_SIDE`] bounds the work and the
 //! peak search's deque for degenerate input (hundreds of returns on one spot); real lines
 //! need at most d_b / spacing ≈ 30 points per side.
 //!
 //! Distances are compared squared (no square root).
 //!
-//! # Sign rule (SPEC §2)
+//! # Sign rule (docs/spec.md §2)
 //!
 //! With a = p_i − p_s, b = p_t − p_i, c = a × b and d = a · b, the unsigned angle between
 //! s→i and i→t is atan2(|c|, d). ρ is positive when i and the scanner (0, 0) lie on
@@ -30,7 +30,7 @@
 //! here depends on the order of s and t, so the sign does not depend on the rotation.
 
 use super::PointStatus;
-use crate::math::{self, Backend};
+use crate::math::{self, Maths};
 
 /// Largest number of points a neighbour window reaches on one side of its point.
 pub const MAX_SIDE: usize = 255;
@@ -60,7 +60,7 @@ fn beyond(x: &[f32], z: &[f32], a: usize, b: usize, d2: f32) -> bool {
 ///
 /// Two forms, the same windows (tested): on 64-bit hosts [`windows_interleaved`], tuned
 /// for an out-of-order CPU; elsewhere (the M4F, in order, no branch predictor to speak of)
-/// [`windows_sweeps`], which counts about half the instructions there.
+/// [`windows_sweeps`], which takes fewer instructions there (docs/benchmarks.md).
 pub(crate) fn windows(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8], t_off: &mut [u8]) -> u32 {
     if cfg!(target_pointer_width = "64") {
         windows_interleaved(x, z, d2, s_off, t_off)
@@ -226,9 +226,8 @@ fn windows_interleaved(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8], t_off: &
 fn left_neighbour(x: &[f32], z: &[f32], d2: f32, s_prev: usize, i: usize) -> usize {
     let mut s = s_prev.max(i.saturating_sub(MAX_SIDE));
     // s usually moves by 0 or 1 per point: take that step without a branch, loop only for
-    // longer moves. (Testing two or four positions at once, branch-free, measured no
-    // faster: each step is a serial chain — load, subtract, square, add, compare — of
-    // about 25 cycles either way.)
+    // longer moves. (Testing two or four positions at once, branch-free, is no faster:
+    // each step is a serial chain — load, subtract, square, add, compare — either way.)
     s += usize::from((s < i) & beyond(x, z, s, i, d2));
     while s < i && beyond(x, z, s, i, d2) {
         s += 1;
@@ -303,8 +302,8 @@ fn judge(x: &[f32], z: &[f32], i: usize, so: usize, to: usize, thr: Threshold) -
     let z = &z[..n];
     let (xi, zi) = (x[i], z[i]);
     // Out of range counts as non-finite: the wire carries any finite f32, but squares of
-    // coordinates near f32::MAX overflow in the bend angle and in smoothing (found by the
-    // `kernel_points` fuzz target), and output packets hold |x′|, |z′| < 2147 m.
+    // coordinates near f32::MAX overflow in the bend angle and in smoothing, and output
+    // packets hold |x′|, |z′| < 2147 m.
     // |v| ≤ MAX_COORD_M compared on the bit patterns of |x′| and |z′| (monotone for
     // non-negative floats; NaN and ±inf lie above): the same test as
     // `(-MAX..=MAX).contains(&v)` on both, in integer instructions.
@@ -438,7 +437,7 @@ fn windows_sweeps_marked(
 /// windows. On the M4F ρ is computed inside the backward sweep, while p_j and its window
 /// are still in registers; elsewhere it is the two calls. The same values either way
 /// (tested).
-pub(crate) fn windows_angles<M: Backend>(
+pub(crate) fn windows_angles<M: Maths>(
     x: &[f32],
     z: &[f32],
     d2: f32,
@@ -459,7 +458,7 @@ pub(crate) fn windows_angles<M: Backend>(
 #[inline(never)] // its own registers (see `mark_irregular`)
 #[cfg_attr(all(not(test), target_pointer_width = "64"), allow(dead_code))]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN counts as beyond, as in `beyond`
-fn windows_sweeps_angles<M: Backend>(
+fn windows_sweeps_angles<M: Maths>(
     x: &[f32],
     z: &[f32],
     d2: f32,
@@ -489,21 +488,15 @@ const MAX_COORD_BITS: u32 = 0x44FA_0000;
 const _: () = assert!(MAX_COORD_M.to_bits() == MAX_COORD_BITS);
 
 /// The signed bend angle at `i` with neighbours `s` and `t`, degrees in (−180, 180]
-/// (SPEC §2 sign rule; see the module docs).
+/// (the sign rule of docs/spec.md §2; see the module docs).
 #[inline(always)]
-pub(crate) fn bend_angle_deg<M: Backend>(
-    x: &[f32],
-    z: &[f32],
-    s: usize,
-    i: usize,
-    t: usize,
-) -> f32 {
+pub(crate) fn bend_angle_deg<M: Maths>(x: &[f32], z: &[f32], s: usize, i: usize, t: usize) -> f32 {
     bend_angle_deg_b::<M>(x, z, s, i, t, (x[t] - x[i], z[t] - z[i]))
 }
 
 /// [`bend_angle_deg`] with b = p_t − p_i already computed (by the backward sweep).
 #[inline(always)]
-fn bend_angle_deg_b<M: Backend>(
+fn bend_angle_deg_b<M: Maths>(
     x: &[f32],
     z: &[f32],
     s: usize,
@@ -517,7 +510,7 @@ fn bend_angle_deg_b<M: Backend>(
     let c = ax * bz - az * bx;
     let d = ax * bx + az * bz;
     // c = d = 0 (a neighbour coincides with p_i: no direction) gives ρ = 0: every
-    // backend's atan2(±0, ±0) is +0 (see `math::Backend`).
+    // backend's atan2(±0, ±0) is +0 (see `math::Maths`).
     let side_o = xs * zt - zs * xt;
     let cs = if side_o > 0.0 {
         c
@@ -538,7 +531,7 @@ fn bend_angle_deg_b<M: Backend>(
 /// ρ on the (smoothed) line for every point, with the offsets from [`windows`]; 0 where a
 /// side has no neighbour.
 #[inline(never)] // its own registers (see `mark_irregular`)
-pub(crate) fn bend_angles<M: Backend>(
+pub(crate) fn bend_angles<M: Maths>(
     x: &[f32],
     z: &[f32],
     s_off: &[u8],

@@ -26,7 +26,7 @@
 //! search and the parameters.
 //! ρ's buffer doubles as the smoothing scratch before ρ is computed.
 
-use crate::math::{self, Backend};
+use crate::math::{self, Maths};
 use crate::scanline::Line;
 
 pub mod bend;
@@ -37,7 +37,10 @@ mod seed;
 mod smooth;
 #[cfg(test)]
 mod synth;
-pub use params::{KernelParams, ParamsError, CONFIG_WORDS};
+/// The config packet's word count, defined by the wire format and re-exported beside the
+/// parameters that fill it.
+pub use crate::wire::CONFIG_WORDS;
+pub use params::{KernelParams, Param, ParamsError};
 
 /// What happened to one input point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -213,7 +216,7 @@ impl<const N: usize> Kernel<N> {
 
     /// [`Kernel::process`] with an explicit maths backend (the micromath tolerance test
     /// runs both backends in one build).
-    pub(crate) fn process_with<'a, M: Backend>(
+    pub(crate) fn process_with<'a, M: Maths>(
         &'a mut self,
         line: &'a mut Line<N>,
     ) -> ScanlineOutput<'a> {
@@ -341,7 +344,7 @@ fn partition(x: &mut [f32], z: &mut [f32], status: &[PointStatus], first_out: us
 /// backwards (points before `first_out` never moved), sets the kept points' statuses from
 /// `aux`, and maps the compact indices `idx` back to input indices.
 #[allow(clippy::too_many_arguments)]
-#[inline(never)] // its own registers: inlined, it spilled the peak search's
+#[inline(never)] // its own registers: inlined, it spills the peak search's
 fn unpartition(
     x: &mut [f32],
     z: &mut [f32],

@@ -22,36 +22,160 @@
 //! little-endian bytes, so the same words always give the same hash on every platform.
 
 use crate::scanline::assemble::{GeometrySplit, SplitParams};
+use crate::wire::CONFIG_WORDS;
 
-/// Number of 32-bit words of the config packet's parameter block.
-pub const CONFIG_WORDS: usize = 16;
+/// One field of [`KernelParams`], named as in the `[kernel]` table of the host's config
+/// file; the discriminant is the field's config word.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
+pub enum Param {
+    /// [`KernelParams::d_b_m`].
+    DBM = 0,
+    /// [`KernelParams::irregular_deg`].
+    IrregularDeg = 1,
+    /// [`KernelParams::tau_min_deg`].
+    TauMinDeg = 2,
+    /// [`KernelParams::tau_max_deg`].
+    TauMaxDeg = 3,
+    /// [`KernelParams::taubin_steps`].
+    TaubinSteps = 4,
+    /// [`KernelParams::taubin_lambda`].
+    TaubinLambda = 5,
+    /// [`KernelParams::taubin_mu`].
+    TaubinMu = 6,
+    /// [`KernelParams::smooth_gap_m`].
+    SmoothGapM = 7,
+    /// [`KernelParams::split_gap_ns`].
+    SplitGapNs = 8,
+    /// [`KernelParams::split_geometry`].
+    SplitGeometry = 9,
+}
+
+impl Param {
+    /// Every parameter, in word order.
+    pub const ALL: [Param; 10] = [
+        Param::DBM,
+        Param::IrregularDeg,
+        Param::TauMinDeg,
+        Param::TauMaxDeg,
+        Param::TaubinSteps,
+        Param::TaubinLambda,
+        Param::TaubinMu,
+        Param::SmoothGapM,
+        Param::SplitGapNs,
+        Param::SplitGeometry,
+    ];
+
+    /// Index of the parameter's config word.
+    pub const fn word(self) -> usize {
+        self as usize
+    }
+
+    /// The field's name (also its key in the host's `[kernel]` table).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Param::DBM => "d_b_m",
+            Param::IrregularDeg => "irregular_deg",
+            Param::TauMinDeg => "tau_min_deg",
+            Param::TauMaxDeg => "tau_max_deg",
+            Param::TaubinSteps => "taubin_steps",
+            Param::TaubinLambda => "taubin_lambda",
+            Param::TaubinMu => "taubin_mu",
+            Param::SmoothGapM => "smooth_gap_m",
+            Param::SplitGapNs => "split_gap_ns",
+            Param::SplitGeometry => "split_geometry",
+        }
+    }
+
+    /// The accepted values, as in the module's table: `(`/`)` exclude the bound, `[`/`]`
+    /// include it; `a..=b` is an integer range. NaN and infinities are never accepted.
+    pub const fn range(self) -> &'static str {
+        match self {
+            Param::DBM => "(0, 10]",
+            Param::IrregularDeg => "(0, 180]",
+            Param::TauMinDeg => "[0, 180)",
+            Param::TauMaxDeg => "(tau_min_deg, 180]",
+            Param::TaubinSteps => "0..=200",
+            Param::TaubinLambda => "(0, 1]",
+            Param::TaubinMu => "[-1, 0)",
+            Param::SmoothGapM => "[0, 100]",
+            Param::SplitGapNs => "any u32",
+            Param::SplitGeometry => "0..=2 (0 = auto, 1 = always, 2 = never)",
+        }
+    }
+
+    /// Whether the word holds f32 bits (otherwise a `u32`).
+    pub const fn is_f32(self) -> bool {
+        !matches!(
+            self,
+            Param::TaubinSteps | Param::SplitGapNs | Param::SplitGeometry
+        )
+    }
+}
 
 /// Why a config block was rejected.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum ParamsError {
-    /// Word `index` is NaN, infinite or outside its documented range.
+    /// A parameter is NaN, infinite or outside its range ([`Param::range`]).
     OutOfRange {
-        /// Index of the offending word.
-        index: u8,
+        /// The parameter.
+        param: Param,
+        /// Its config word as given (f32 bits or a `u32`, see [`Param::is_f32`]).
+        word: u32,
     },
     /// A reserved word is not zero.
     ReservedNotZero {
-        /// Index of the offending word.
+        /// Index of the word.
         index: u8,
+        /// The word as given.
+        word: u32,
     },
 }
 
-/// Every parameter of the kernel (Honma et al. §2.3–2.6) and of scanline assembly (SPEC §2,
-/// *Scanline*), so that one config packet configures the whole core.
+impl core::fmt::Display for ParamsError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            ParamsError::OutOfRange { param, word } => {
+                write!(f, "{} = ", param.name())?;
+                if param.is_f32() {
+                    write!(f, "{}", f32::from_bits(word))?;
+                } else {
+                    write!(f, "{word}")?;
+                }
+                write!(f, " is outside its range {}", param.range())
+            }
+            ParamsError::ReservedNotZero { index, word } => write!(
+                f,
+                "config word {index} is reserved and must be 0, not {word:#010x}"
+            ),
+        }
+    }
+}
+
+impl core::error::Error for ParamsError {}
+
+/// Every parameter of the kernel (Honma et al. §2.3–2.6) and of scanline assembly
+/// (docs/spec.md §2, *Scanline*), so that one config packet configures the whole core.
 ///
 /// The paper gives the Taubin values (§2.5) and nothing else numerically; every other
-/// default below says how it was chosen. The target is a VQ-250-class line (SPEC, paper
+/// default below says how it was chosen. The target is a VQ-250-class line (Honma et al.
 /// Table 1): about 10 mm point spacing on the road near the scanner, about 35 mm at 5 m,
 /// up to about 140 mm at the far curb; curbs 80–200 mm high; curb cuts 20–30 mm steps.
+///
+/// With the `serde` feature it (de)serialises as a table of its fields under their own
+/// names; missing fields take their defaults and unknown ones are rejected, so a typo does
+/// not silently leave a default in force. Deserialising does not check ranges: call
+/// [`Self::validate`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(default, deny_unknown_fields)
+)]
 pub struct KernelParams {
     /// d_b: neighbour distance for the bend angle, metres (§2.3: s and t are the farthest
     /// points within d_b of p_i, walking outward along the scanline).
@@ -60,13 +184,13 @@ pub struct KernelParams {
     /// lowest common curbs (80 mm): with d_b < h the toe of a step is a sharp +90° peak (s on
     /// the road, t on the face), while with d_b > h the far neighbour lands on the curb top
     /// for every road point within √(d_b² − h²) of the toe and ρ forms a plateau of
-    /// asin(h/d_b) there, which lets noise place the peak anywhere on it. Measured on the
-    /// synthetic scanline (`kernel::tests`, 5 mm noise, 80 runs): 80 mm curbs give a worst
-    /// candidate 20 mm from the toe with 0.07 m against 61 mm with 0.10 m and 97 mm with
-    /// 0.13 m; 150 mm curbs are the same for all three (≤ 19 mm). 0.07 m still spans 7
-    /// points at 10 mm spacing and 2 at 35 mm (5 m out), enough to average the noise. At
-    /// the far curb (≈140 mm spacing) road points have no neighbour within d_b and get
-    /// [`super::PointStatus::NoNeighbour`]; the host's tracking (§2.7) covers that side.
+    /// asin(h/d_b) there, which lets noise place the peak anywhere on it. On the synthetic
+    /// scanline of `kernel::tests` (5 mm noise), 0.07 m puts the candidates of 80 mm curbs
+    /// nearer the toe than 0.10 m or 0.13 m do; on 150 mm curbs the three agree. 0.07 m
+    /// still spans 7 points at 10 mm spacing and 2 at 35 mm (5 m out), enough to average
+    /// the noise. At the far curb (≈140 mm spacing) road points have no neighbour within
+    /// d_b and get [`super::PointStatus::NoNeighbour`]; the host's tracking (§2.7) covers
+    /// that side.
     pub d_b_m: f32,
     /// Threshold for the removal of irregular points, degrees (§2.4: points with |ρ| above
     /// it on the raw line are removed before smoothing).
@@ -83,9 +207,9 @@ pub struct KernelParams {
     /// Default 35° — not given by the paper ("close to 90 degrees"). Far below the toe of
     /// any curb taller than d_b (≈90°, somewhat less after smoothing rounds the corner) and
     /// below a 40 mm step's asin(0.04/0.07) ≈ 35°, yet well above road crown, ruts and the
-    /// 5 mm noise left after smoothing (a few degrees; no false candidate in the 80
-    /// synthetic runs). Curb cuts (20–30 mm steps, ρ ≈ 17–25°) give no peak; the host
-    /// tracks through them (§2.7).
+    /// 5 mm noise left after smoothing (a few degrees; the synthetic lines of
+    /// `kernel::tests` give no false candidate). Curb cuts (20–30 mm steps, ρ ≈ 17–25°)
+    /// give no peak; the host tracks through them (§2.7).
     pub tau_min_deg: f32,
     /// τ_ρmax: upper bound (exclusive) of the bend angle of a peak, degrees (§2.6).
     ///
@@ -109,7 +233,7 @@ pub struct KernelParams {
     /// bends; fixing both sides of a gap keeps the paper's "ends fixed" per visible piece.
     /// 0.30 m is twice the largest spacing expected on the road (≈140 mm at the far curb).
     pub smooth_gap_m: f32,
-    /// Assembly (`scanline::assemble`, SPEC §2 *Scanline*): a time step between
+    /// Assembly (`scanline::assemble`, docs/spec.md §2 *Scanline*): a time step between
     /// consecutive points longer than this ends the line, nanoseconds.
     ///
     /// Default 5 ms — the assembler's own default ([`SplitParams::DEFAULT`]): half a
@@ -157,46 +281,52 @@ impl KernelParams {
 
     /// Parses and checks a parameter block; the first offending word is reported.
     pub fn from_words(words: &[u32; CONFIG_WORDS]) -> Result<Self, ParamsError> {
-        // `lo_open`: whether the lower bound itself is excluded.
+        // `lo_open`: whether the lower bound itself is excluded (likewise `hi_open`).
         fn f(
             words: &[u32; CONFIG_WORDS],
-            index: usize,
+            param: Param,
             lo: f32,
             lo_open: bool,
             hi: f32,
             hi_open: bool,
         ) -> Result<f32, ParamsError> {
-            let v = f32::from_bits(words[index]);
+            let word = words[param.word()];
+            let v = f32::from_bits(word);
             // NaN fails every comparison, so it is rejected here too.
             let above = if lo_open { v > lo } else { v >= lo };
             let below = if hi_open { v < hi } else { v <= hi };
             if above && below {
                 Ok(v)
             } else {
-                Err(ParamsError::OutOfRange { index: index as u8 })
+                Err(ParamsError::OutOfRange { param, word })
             }
         }
-        for (index, &w) in words.iter().enumerate().skip(FIRST_RESERVED) {
-            if w != 0 {
-                return Err(ParamsError::ReservedNotZero { index: index as u8 });
+        fn int(words: &[u32; CONFIG_WORDS], param: Param, max: u32) -> Result<u32, ParamsError> {
+            let word = words[param.word()];
+            if word <= max {
+                Ok(word)
+            } else {
+                Err(ParamsError::OutOfRange { param, word })
             }
         }
-        let d_b_m = f(words, 0, 0.0, true, 10.0, false)?;
-        let irregular_deg = f(words, 1, 0.0, true, 180.0, false)?;
-        let tau_min_deg = f(words, 2, 0.0, false, 180.0, true)?;
-        let tau_max_deg = f(words, 3, tau_min_deg, true, 180.0, false)?;
-        let taubin_steps = words[4];
-        if taubin_steps > 200 {
-            return Err(ParamsError::OutOfRange { index: 4 });
+        for (index, &word) in words.iter().enumerate().skip(FIRST_RESERVED) {
+            if word != 0 {
+                return Err(ParamsError::ReservedNotZero {
+                    index: index as u8,
+                    word,
+                });
+            }
         }
-        let taubin_lambda = f(words, 5, 0.0, true, 1.0, false)?;
-        let taubin_mu = f(words, 6, -1.0, false, 0.0, true)?;
-        let smooth_gap_m = f(words, 7, 0.0, false, 100.0, false)?;
-        let split_gap_ns = words[8];
-        let split_geometry = words[9];
-        if split_geometry > 2 {
-            return Err(ParamsError::OutOfRange { index: 9 });
-        }
+        let d_b_m = f(words, Param::DBM, 0.0, true, 10.0, false)?;
+        let irregular_deg = f(words, Param::IrregularDeg, 0.0, true, 180.0, false)?;
+        let tau_min_deg = f(words, Param::TauMinDeg, 0.0, false, 180.0, true)?;
+        let tau_max_deg = f(words, Param::TauMaxDeg, tau_min_deg, true, 180.0, false)?;
+        let taubin_steps = int(words, Param::TaubinSteps, 200)?;
+        let taubin_lambda = f(words, Param::TaubinLambda, 0.0, true, 1.0, false)?;
+        let taubin_mu = f(words, Param::TaubinMu, -1.0, false, 0.0, true)?;
+        let smooth_gap_m = f(words, Param::SmoothGapM, 0.0, false, 100.0, false)?;
+        let split_gap_ns = words[Param::SplitGapNs.word()];
+        let split_geometry = int(words, Param::SplitGeometry, 2)?;
         Ok(Self {
             d_b_m,
             irregular_deg,
@@ -317,42 +447,160 @@ mod tests {
     }
 
     #[test]
-    fn bad_words_are_rejected_with_their_index() {
+    fn bad_words_are_rejected_naming_their_parameter() {
         let good = KernelParams::DEFAULT.to_words();
-        let cases: [(usize, u32); 12] = [
-            (0, f32::NAN.to_bits()),
-            (0, 0.0f32.to_bits()),
-            (0, (-0.1f32).to_bits()),
-            (1, f32::INFINITY.to_bits()),
-            (1, 181.0f32.to_bits()),
-            (2, (-1.0f32).to_bits()),
-            (3, 30.0f32.to_bits()), // below τ_min = 35
-            (4, 201),
-            (5, 1.5f32.to_bits()),
-            (6, 0.5f32.to_bits()),
-            (7, f32::NEG_INFINITY.to_bits()),
-            (9, 3),
+        let cases: [(Param, u32); 12] = [
+            (Param::DBM, f32::NAN.to_bits()),
+            (Param::DBM, 0.0f32.to_bits()),
+            (Param::DBM, (-0.1f32).to_bits()),
+            (Param::IrregularDeg, f32::INFINITY.to_bits()),
+            (Param::IrregularDeg, 181.0f32.to_bits()),
+            (Param::TauMinDeg, (-1.0f32).to_bits()),
+            (Param::TauMaxDeg, 30.0f32.to_bits()), // below τ_min = 35
+            (Param::TaubinSteps, 201),
+            (Param::TaubinLambda, 1.5f32.to_bits()),
+            (Param::TaubinMu, 0.5f32.to_bits()),
+            (Param::SmoothGapM, f32::NEG_INFINITY.to_bits()),
+            (Param::SplitGeometry, 3),
         ];
-        for (index, bad) in cases {
+        for (param, word) in cases {
             let mut w = good;
-            w[index] = bad;
+            w[param.word()] = word;
             assert_eq!(
                 KernelParams::from_words(&w),
-                Err(ParamsError::OutOfRange { index: index as u8 }),
-                "word {index}"
+                Err(ParamsError::OutOfRange { param, word }),
+                "{param:?}"
             );
         }
         let mut w = good;
         w[10] = 1;
         assert_eq!(
             KernelParams::from_words(&w),
-            Err(ParamsError::ReservedNotZero { index: 10 })
+            Err(ParamsError::ReservedNotZero { index: 10, word: 1 })
         );
         let mut w = good;
-        w[13] = 1;
+        w[13] = 7;
         assert_eq!(
             KernelParams::from_words(&w),
-            Err(ParamsError::ReservedNotZero { index: 13 })
+            Err(ParamsError::ReservedNotZero { index: 13, word: 7 })
         );
+    }
+
+    /// The messages a user reads: the field's name, the value given and the range.
+    #[test]
+    fn error_messages_name_the_field_value_and_range() {
+        extern crate std;
+        use std::string::ToString;
+        let msg = |p: KernelParams| p.validate().unwrap_err().to_string();
+        assert_eq!(
+            msg(KernelParams {
+                tau_max_deg: 30.0,
+                ..KernelParams::DEFAULT
+            }),
+            "tau_max_deg = 30 is outside its range (tau_min_deg, 180]"
+        );
+        assert_eq!(
+            msg(KernelParams {
+                d_b_m: f32::NAN,
+                ..KernelParams::DEFAULT
+            }),
+            "d_b_m = NaN is outside its range (0, 10]"
+        );
+        assert_eq!(
+            msg(KernelParams {
+                taubin_mu: -1.5,
+                ..KernelParams::DEFAULT
+            }),
+            "taubin_mu = -1.5 is outside its range [-1, 0)"
+        );
+        assert_eq!(
+            msg(KernelParams {
+                taubin_steps: 500,
+                ..KernelParams::DEFAULT
+            }),
+            "taubin_steps = 500 is outside its range 0..=200"
+        );
+        assert_eq!(
+            msg(KernelParams {
+                split_geometry: 3,
+                ..KernelParams::DEFAULT
+            }),
+            "split_geometry = 3 is outside its range 0..=2 (0 = auto, 1 = always, 2 = never)"
+        );
+        let mut w = KernelParams::DEFAULT.to_words();
+        w[12] = 0xff;
+        assert_eq!(
+            KernelParams::from_words(&w).unwrap_err().to_string(),
+            "config word 12 is reserved and must be 0, not 0x000000ff"
+        );
+    }
+
+    /// [`Param::range`] is what `from_words` enforces: for every f32 parameter, the bounds
+    /// read from the range text are accepted or rejected as its brackets say, and the next
+    /// float outside each bound is rejected; integer ranges likewise at `max` and `max + 1`.
+    #[test]
+    fn range_texts_match_the_checks() {
+        extern crate std;
+        let base = KernelParams {
+            tau_min_deg: 10.0,
+            tau_max_deg: 180.0,
+            ..KernelParams::DEFAULT
+        }
+        .to_words();
+        let next_up = |v: f32| {
+            if v == 0.0 {
+                f32::from_bits(1)
+            } else if v > 0.0 {
+                f32::from_bits(v.to_bits() + 1)
+            } else {
+                f32::from_bits(v.to_bits() - 1)
+            }
+        };
+        let next_down = |v: f32| -next_up(-v);
+        let accepts = |param: Param, word: u32| {
+            let mut w = base;
+            w[param.word()] = word;
+            match KernelParams::from_words(&w) {
+                Ok(_) => true,
+                Err(e) => {
+                    assert_eq!(e, ParamsError::OutOfRange { param, word });
+                    false
+                }
+            }
+        };
+        for param in Param::ALL {
+            assert_eq!(
+                param.word(),
+                Param::ALL.iter().position(|&p| p == param).unwrap()
+            );
+            let text = param.range();
+            if param.is_f32() {
+                let (lo_open, hi_open) = (text.starts_with('('), text.ends_with(')'));
+                let inner = &text[1..text.len() - 1];
+                let (lo, hi) = inner.split_once(", ").unwrap();
+                let lo: f32 = if lo == "tau_min_deg" {
+                    10.0
+                } else {
+                    lo.parse().unwrap()
+                };
+                let hi: f32 = hi.parse().unwrap();
+                assert_eq!(accepts(param, lo.to_bits()), !lo_open, "{text}");
+                assert_eq!(accepts(param, hi.to_bits()), !hi_open, "{text}");
+                assert!(accepts(param, next_up(lo).to_bits()), "{text}");
+                assert!(accepts(param, next_down(hi).to_bits()), "{text}");
+                assert!(!accepts(param, next_down(lo).to_bits()), "{text}");
+                assert!(!accepts(param, next_up(hi).to_bits()), "{text}");
+                assert!(!accepts(param, f32::NAN.to_bits()), "{text}");
+            } else if text == "any u32" {
+                assert!(accepts(param, 0) && accepts(param, u32::MAX));
+            } else {
+                let ints = text.split(' ').next().unwrap();
+                let (lo, hi) = ints.split_once("..=").unwrap();
+                let (lo, hi): (u32, u32) = (lo.parse().unwrap(), hi.parse().unwrap());
+                assert_eq!(lo, 0);
+                assert!(accepts(param, hi), "{text}");
+                assert!(!accepts(param, hi + 1), "{text}");
+            }
+        }
     }
 }

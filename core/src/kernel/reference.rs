@@ -1,4 +1,4 @@
-//! A plain f64 implementation of the kernel, written straight from SPEC §2 and the paper
+//! A plain f64 implementation of the kernel, written straight from docs/spec.md §2 and the paper
 //! (§2.3–2.6) for the differential test: neighbours by walking outward from each point,
 //! ρ as the difference of the two directions' angles (atan2 each) with the side rule as
 //! two orientation tests, removal by |ρ| > threshold, Taubin with a copy per step, peaks by
@@ -33,8 +33,8 @@ fn dist(x: &[f64], z: &[f64], a: usize, b: usize) -> f64 {
     libm::hypot(x[a] - x[b], z[a] - z[b])
 }
 
-/// SPEC §2's walk outward from each point; returns (s, t) per point. Used to measure how
-/// often the kernel's sweep differs from it.
+/// The walk outward from each point of docs/spec.md §2; returns (s, t) per point. Used to
+/// count how often the kernel's sweep differs from it.
 pub fn windows_walk(x: &[f64], z: &[f64], d_b: f64) -> (Vec<usize>, Vec<usize>) {
     let n = x.len();
     let (mut s, mut t) = (Vec::with_capacity(n), Vec::with_capacity(n));

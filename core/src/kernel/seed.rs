@@ -1,4 +1,4 @@
-//! Peaks, nadir and the per-scanline seed candidates (Honma et al. §2.6, SPEC §2).
+//! Peaks, nadir and the per-scanline seed candidates (Honma et al. §2.6, docs/spec.md §2).
 //!
 //! - Nadir: the point with the smallest |x′| among points with z′ < 0 (first one on a tie).
 //! - Peak: ρ_i is the largest ρ within i's d_b window (ties count: ρ_i ≥ every ρ_j in the

@@ -3,7 +3,7 @@
 //! One step moves every interior point towards the mean of its two neighbours (w = 0.5 on
 //! each, the reciprocal of the neighbour count): p ← p + a·(½(p₋ + p₊) − p), with a = λ on
 //! even steps and a = μ on odd steps (λ = 0.6307, μ = −0.6732, 20 steps: ten λ/μ pairs).
-//! The two end points stay fixed (SPEC §2). Where consecutive points are farther apart than
+//! The two end points stay fixed (docs/spec.md §2). Where consecutive points are farther apart than
 //! `smooth_gap_m`, the line is smoothed as separate pieces, each with its ends fixed (see
 //! [`super::KernelParams::smooth_gap_m`]).
 //!

@@ -313,9 +313,10 @@ fn weeds_move_the_candidate_by_at_most_30_mm() {
 
 #[test]
 fn sweep_windows_equal_the_spec_walk_on_synthetic_scanlines() {
-    // SPEC §2 walks outward from each point; the kernel sweeps. They differ only where the
-    // line folds back within d_b — on raw lines with 5 mm noise at 4 mm spacing that is
-    // common, on the smoothed line (where the output ρ comes from) rare. Measured here.
+    // docs/spec.md §2 walks outward from each point; the kernel sweeps. They differ only
+    // where the line folds back within d_b — on raw lines with 5 mm noise at 4 mm spacing
+    // that is common, on the smoothed line (where the output ρ comes from) rare. This test
+    // counts both and bounds them.
     let p = KernelParams::DEFAULT;
     let d_b = f64::from(p.d_b_m);
     let (mut raw_same, mut raw_total, mut same, mut total) = (0usize, 0usize, 0usize, 0usize);
@@ -441,11 +442,11 @@ fn random_profile(rng: &mut Rng) -> Vec<(f64, f64)> {
 }
 
 /// ρ tolerance of the kernel against the f64 reference, degrees: smoothed coordinates agree
-/// within about 1.5e-6 m (measured 1.33e-6), neighbours are at least 6 mm away, so
+/// within about 1.5e-6 m, neighbours are at least 6 mm away, so
 /// 1.5e-6 / 6e-3 rad ≈ 0.015°.
 #[cfg(not(feature = "micromath"))]
 const RHO_TOL_DEG: f64 = 0.02;
-/// micromath's atan2 is within 0.162° (TOOLCHAIN.md).
+/// micromath's atan2 is within about 0.16°.
 #[cfg(feature = "micromath")]
 const RHO_TOL_DEG: f64 = 0.2;
 
@@ -696,8 +697,8 @@ fn stage_timings() {
     std::println!("whole process: {r:.1?} ns/pt");
 }
 
-/// Regression (fuzz target `kernel_points`, fuzz/regressions/kernel_points/): finite but
-/// huge coordinates overflowed in smoothing and gave non-finite smoothed points.
+/// Finite but huge coordinates would overflow in smoothing and give non-finite smoothed
+/// points: the kernel sets them aside as non-finite, and every output value stays finite.
 #[test]
 fn huge_finite_coordinates_are_set_aside_and_every_output_stays_finite() {
     let mut pts = ideal_curb(false, false);

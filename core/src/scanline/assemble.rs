@@ -1,4 +1,4 @@
-//! Scanline assembly (SPEC §2; Honma et al. §2.2 treat each revolution of the mirror as one
+//! Scanline assembly (docs/spec.md §2; Honma et al. §2.2 treat each revolution of the mirror as one
 //! scanline): points arrive in acquisition order and are cut into lines.
 //!
 //! # Split rules

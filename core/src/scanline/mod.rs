@@ -42,8 +42,8 @@ pub mod ring;
 pub use assemble::{GeometrySplit, SplitParams, SplitReason};
 pub use ingest::{Ingest, IngestCounters, IngestEvent};
 
-/// One assembled scanline in structure-of-arrays form (SPEC §2: points in acquisition order,
-/// one revolution of the mirror). Filled by [`assemble::Assembler`], processed in place by
+/// One assembled scanline in structure-of-arrays form (docs/spec.md §2: points in
+/// acquisition order, one revolution of the mirror). Filled by [`assemble::Assembler`], processed in place by
 /// [`crate::kernel::Kernel`].
 ///
 /// Capacity `N` is the largest number of points one line can hold (`MAX_POINTS`); points

@@ -14,13 +14,12 @@
 //!
 //! Three software forms, bit-identical (tested): byte-at-a-time with one 256-entry table
 //! (1 KiB), slicing-by-4 (the first 4 KiB of the tables; one 32-bit load and four
-//! lookups per 4 bytes, 16 bytes per loop iteration — the form for the M4F: 3.4
-//! instructions per byte there against 5.5 byte-at-a-time, `docs/benchmarks.md`) and
+//! lookups per 4 bytes, 16 bytes per loop iteration — the form for the M4F, fewer
+//! instructions per byte there than byte-at-a-time, `docs/benchmarks.md`) and
 //! slicing-by-8 (8 KiB of tables, several times faster on a host CPU). On the M4F
 //! slicing-by-8 cannot win: per 8 bytes it needs the same 2 loads, 8 byte extractions,
 //! 8 lookups and 8 XORs as two slicing-by-4 steps, and its 8 table bases do not fit the
-//! registers beside the loop's own (measured on the firmware: ingest's CRC 70.0 against
-//! 68.7 instructions per point, output's 66.2 against 56.2). [`Crc32`] uses slicing-by-8
+//! registers beside the loop's own, so it spills. [`Crc32`] uses slicing-by-8
 //! on targets with 64-bit pointers and slicing-by-4 elsewhere.
 //!
 //! The STM32F405's CRC unit would do a 32-bit word per bus write (see above), but QEMU

@@ -48,7 +48,6 @@ mod output;
 mod points;
 mod scan;
 
-pub use crate::kernel::CONFIG_WORDS;
 pub use encoder::StreamEncoder;
 pub use output::{
     OutputColumns, OutputHeaderRepr, OutputPointRepr, OutputPoints, OUTPUT_HEADER_LEN,
@@ -80,6 +79,9 @@ pub const MAX_POINTS_PER_PACKET: usize = 64;
 /// The largest number of output points in one output packet (1464 bytes).
 pub const MAX_OUTPUT_POINTS_PER_PACKET: usize =
     (MAX_PACKET_LEN - HEADER_LEN - OUTPUT_HEADER_LEN - CRC_LEN) / OUTPUT_POINT_LEN;
+/// Number of 32-bit words in a config packet's payload. The wire layer carries them
+/// opaquely; `kernel::KernelParams` converts parameters to and from them.
+pub const CONFIG_WORDS: usize = 16;
 /// Length of a config packet (fixed).
 pub const CONFIG_PACKET_LEN: usize = HEADER_LEN + 4 * CONFIG_WORDS + CRC_LEN;
 
@@ -244,6 +246,77 @@ pub enum EncodeError {
         index: usize,
     },
 }
+
+impl core::fmt::Display for Error {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Error::Truncated { needed, available } => write!(
+                f,
+                "packet truncated: {needed} bytes needed, {available} available"
+            ),
+            Error::BadSync => write!(f, "packet does not start with the sync bytes A5 C3"),
+            Error::BadVersion { version } => write!(
+                f,
+                "packet has format version {version}, this code reads version {VERSION}"
+            ),
+            Error::BadKind { kind } => write!(f, "packet kind {kind} is not a known kind"),
+            Error::BadLength { length } => write!(
+                f,
+                "packet length field {length} is outside {MIN_PACKET_LEN}..={MAX_PACKET_LEN} \
+                 or does not fit the packet's kind"
+            ),
+            Error::Crc { stored, computed } => write!(
+                f,
+                "packet CRC mismatch: stored {stored:#010x}, computed {computed:#010x}"
+            ),
+            Error::ReservedNotZero { offset } => {
+                write!(
+                    f,
+                    "reserved field at byte {offset} of the packet is not zero"
+                )
+            }
+            Error::NonFinite { offset } => {
+                write!(
+                    f,
+                    "float field at byte {offset} of the packet is NaN or infinite"
+                )
+            }
+            Error::OutOfRange { offset } => {
+                write!(
+                    f,
+                    "field at byte {offset} of the packet is out of its range"
+                )
+            }
+            Error::WrongKind { kind } => {
+                write!(f, "packet is of kind {kind}, not the kind asked for")
+            }
+        }
+    }
+}
+
+impl core::error::Error for Error {}
+
+impl core::fmt::Display for EncodeError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            EncodeError::BufferTooSmall { needed, available } => write!(
+                f,
+                "output buffer too small: {needed} bytes needed, {available} available"
+            ),
+            EncodeError::TooManyPoints { count, max } => {
+                write!(f, "{count} items do not fit one packet (at most {max})")
+            }
+            EncodeError::NonFinite { index } => {
+                write!(f, "item {index} has a NaN or infinite value")
+            }
+            EncodeError::OutOfRange { index } => {
+                write!(f, "item {index} has a value that does not fit its field")
+            }
+        }
+    }
+}
+
+impl core::error::Error for EncodeError {}
 
 /// The kind byte of a packet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -504,7 +577,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ConfigRepr {
-    /// Opaque to the wire layer; [`crate::kernel::KernelParams`] gives them meaning.
+    /// Opaque to the wire layer; `kernel::KernelParams` gives them meaning.
     pub words: [u32; CONFIG_WORDS],
 }
 
@@ -571,6 +644,87 @@ mod tests {
         let crc = crc::crc32_bytewise(&g[..CONFIG_PACKET_LEN - 4]);
         g[CONFIG_PACKET_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
         g
+    }
+
+    /// The messages a user reads are sentences with the numbers of the case.
+    #[test]
+    fn error_messages() {
+        use std::string::ToString;
+        let cases: [(Error, &str); 10] = [
+            (
+                Error::Truncated {
+                    needed: 80,
+                    available: 12,
+                },
+                "packet truncated: 80 bytes needed, 12 available",
+            ),
+            (
+                Error::BadSync,
+                "packet does not start with the sync bytes A5 C3",
+            ),
+            (
+                Error::BadVersion { version: 2 },
+                "packet has format version 2, this code reads version 1",
+            ),
+            (
+                Error::BadKind { kind: 9 },
+                "packet kind 9 is not a known kind",
+            ),
+            (
+                Error::BadLength { length: 3 },
+                "packet length field 3 is outside 16..=1472 or does not fit the packet's kind",
+            ),
+            (
+                Error::Crc {
+                    stored: 0xdead_beef,
+                    computed: 0x1234,
+                },
+                "packet CRC mismatch: stored 0xdeadbeef, computed 0x00001234",
+            ),
+            (
+                Error::ReservedNotZero { offset: 6 },
+                "reserved field at byte 6 of the packet is not zero",
+            ),
+            (
+                Error::NonFinite { offset: 24 },
+                "float field at byte 24 of the packet is NaN or infinite",
+            ),
+            (
+                Error::OutOfRange { offset: 64 },
+                "field at byte 64 of the packet is out of its range",
+            ),
+            (
+                Error::WrongKind { kind: 2 },
+                "packet is of kind 2, not the kind asked for",
+            ),
+        ];
+        for (e, want) in cases {
+            assert_eq!(e.to_string(), want);
+        }
+        let cases: [(EncodeError, &str); 4] = [
+            (
+                EncodeError::BufferTooSmall {
+                    needed: 80,
+                    available: 10,
+                },
+                "output buffer too small: 80 bytes needed, 10 available",
+            ),
+            (
+                EncodeError::TooManyPoints { count: 65, max: 64 },
+                "65 items do not fit one packet (at most 64)",
+            ),
+            (
+                EncodeError::NonFinite { index: 3 },
+                "item 3 has a NaN or infinite value",
+            ),
+            (
+                EncodeError::OutOfRange { index: 4 },
+                "item 4 has a value that does not fit its field",
+            ),
+        ];
+        for (e, want) in cases {
+            assert_eq!(e.to_string(), want);
+        }
     }
 
     #[test]

@@ -17,9 +17,9 @@ pub const POINT_FLAG_LINE_START: u16 = 1;
 pub struct PointRecord {
     /// Time offset from the packet's base time, nanoseconds.
     pub dt_ns: u32,
-    /// x′ in metres: signed lateral offset from the scanner, left positive (SPEC §2).
+    /// x′ in metres: signed lateral offset from the scanner, left positive (docs/spec.md §2).
     pub x_m: f32,
-    /// z′ in metres: height relative to the scanner origin (SPEC §2).
+    /// z′ in metres: height relative to the scanner origin (docs/spec.md §2).
     pub z_m: f32,
     /// Return intensity as the source reports it.
     pub intensity: u16,

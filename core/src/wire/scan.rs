@@ -87,8 +87,7 @@ pub(crate) fn copy_from_two(a: &[u8], b: &[u8], start: usize, dst: &mut [u8]) ->
 
 /// CRC-32 of bytes `0..end` of `a ++ b` (caller guarantees `end ≤ a.len() + b.len()`).
 /// Out of line: inlined into the ingest loop, the CRC's table bases and the loop's own
-/// registers competed and both spilled (measured on the M4F: +14 instructions per point
-/// for the CRC, +32 for the rest of ingest).
+/// registers compete and both spill on the M4F.
 #[inline(never)]
 fn crc_two(a: &[u8], b: &[u8], end: usize) -> u32 {
     let mut c = Crc32::new();
@@ -258,7 +257,7 @@ mod tests {
         let mut enc = StreamEncoder::new();
         let mut buf = [0u8; 200];
         let n = enc
-            .encode_config(&[5; crate::kernel::CONFIG_WORDS], &mut buf)
+            .encode_config(&[5; crate::wire::CONFIG_WORDS], &mut buf)
             .unwrap();
         for cut in 0..=n {
             let (a, b) = buf[..n].split_at(cut);

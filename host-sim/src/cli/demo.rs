@@ -225,7 +225,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     write_geojson(&out.join("edges.geojson"), &ex.edges, Some(&crs))?;
 
     // 3. One scanline through the core, for the cross-section picture.
-    let profile = scanline_profile(&sim, &cfg.kernel.to_params());
+    let profile = scanline_profile(&sim, &cfg.kernel);
 
     // 4. Evaluate, draw, report.
     let [x, y, z] = sim.world_columns();

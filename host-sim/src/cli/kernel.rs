@@ -118,9 +118,13 @@ fn run_inner(args: Args) -> anyhow::Result<()> {
         "points {} in, {} in lines, {} truncated, {} non-finite; {lines} lines, {candidates} candidates",
         c.points_in, c.points_in_lines, c.points_truncated, c.points_non_finite
     );
+    if let Some(e) = pc.last_config_error {
+        eprintln!("last refused config packet: {e}");
+    }
     eprintln!(
-        "written {out_bytes} bytes of output packets to {}",
-        args.output.display()
+        "written {out_bytes} bytes of output packets to {} (core maths: {})",
+        args.output.display(),
+        curbtrace_core::math::BACKEND
     );
     Ok(())
 }

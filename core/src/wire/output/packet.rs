@@ -1,0 +1,253 @@
+//! The output packet: the per-line header every fragment repeats, parsing a packet into
+//! header and points, and writing one fragment point by point.
+
+use super::super::{
+    emit_header, field, get_u16, get_u32, get_u64, put_bytes, seal, EncodeError, Error, Packet,
+    PacketKind, CRC_LEN, MAX_OUTPUT_POINTS_PER_PACKET,
+};
+use super::{output_packet_len, OutputPointRepr, NO_INDEX, OUTPUT_POINT_LEN};
+
+/// The per-line part of an output packet (repeated in every fragment).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct OutputHeaderRepr {
+    /// Scanline number in the stream.
+    pub index: u32,
+    /// Absolute time of the line's first point, GPS nanoseconds.
+    pub start_time_ns: u64,
+    /// Hash of the kernel parameters that produced the output.
+    pub params_hash: u32,
+    /// Points of the line dropped by assembly (line over capacity).
+    pub truncated: u32,
+    /// Points in the whole line (all fragments).
+    pub line_len: u16,
+    /// Index within the line of this fragment's first point (the encoder sets it).
+    pub first: u16,
+    /// Index of the nadir point, if any (`< line_len`).
+    pub nadir: Option<u16>,
+    /// Index of the left seed candidate, if any (`< line_len`).
+    pub left: Option<u16>,
+    /// Index of the right seed candidate, if any (`< line_len`).
+    pub right: Option<u16>,
+    /// Kernel counter: points kept.
+    pub kept: u16,
+    /// Kernel counter: points removed as irregular.
+    pub irregular: u16,
+    /// Kernel counter: points without a neighbour on one side.
+    pub no_neighbour: u16,
+    /// Kernel counter: peaks found.
+    pub peaks: u16,
+}
+
+impl OutputHeaderRepr {
+    /// Number of packets the line takes.
+    pub fn fragments(&self) -> usize {
+        usize::from(self.line_len)
+            .div_ceil(MAX_OUTPUT_POINTS_PER_PACKET)
+            .max(1)
+    }
+
+    /// The first point of fragment `k` (`k < fragments()`), as the packet carries it.
+    pub(crate) fn fragment_first(k: usize) -> Result<u16, EncodeError> {
+        k.checked_mul(MAX_OUTPUT_POINTS_PER_PACKET)
+            .and_then(|f| u16::try_from(f).ok())
+            .ok_or(EncodeError::OutOfRange { index: k })
+    }
+
+    /// Checks the index fields against `line_len`.
+    fn indices_ok(&self) -> bool {
+        [self.nadir, self.left, self.right]
+            .iter()
+            .all(|i| i.is_none_or(|v| v < self.line_len))
+    }
+}
+
+fn opt_index(v: u16) -> Option<u16> {
+    (v != NO_INDEX).then_some(v)
+}
+
+/// The points of a parsed output packet (already validated by [`OutputHeaderRepr::parse`]).
+#[derive(Clone, Debug)]
+pub struct OutputPoints<'a> {
+    rest: core::slice::ChunksExact<'a, u8>,
+}
+
+impl Iterator for OutputPoints<'_> {
+    type Item = OutputPointRepr;
+    fn next(&mut self) -> Option<Self::Item> {
+        // Validated in parse; a failure here cannot happen and ends the iteration.
+        self.rest
+            .next()
+            .and_then(|b| OutputPointRepr::parse(b).ok())
+    }
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        self.rest.size_hint()
+    }
+}
+
+impl ExactSizeIterator for OutputPoints<'_> {}
+
+impl OutputHeaderRepr {
+    /// Parses an output packet (full check: CRC, version, kind, length, header fields and
+    /// every point) and returns its header and its points.
+    pub fn parse<T: AsRef<[u8]>>(packet: &Packet<T>) -> Result<(Self, OutputPoints<'_>), Error> {
+        let kind = packet.check()?;
+        if kind != PacketKind::Output {
+            return Err(Error::WrongKind { kind: kind as u8 });
+        }
+        let b = packet.bytes();
+        use field::out;
+        let h = Self {
+            index: get_u32(b, out::INDEX),
+            start_time_ns: get_u64(b, out::START_TIME),
+            params_hash: get_u32(b, out::PARAMS_HASH),
+            truncated: get_u32(b, out::TRUNCATED),
+            line_len: get_u16(b, out::LINE_LEN),
+            first: get_u16(b, out::FIRST),
+            nadir: opt_index(get_u16(b, out::NADIR)),
+            left: opt_index(get_u16(b, out::LEFT)),
+            right: opt_index(get_u16(b, out::RIGHT)),
+            kept: get_u16(b, out::KEPT),
+            irregular: get_u16(b, out::IRREGULAR),
+            no_neighbour: get_u16(b, out::NO_NEIGHBOUR),
+            peaks: get_u16(b, out::PEAKS),
+        };
+        if get_u16(b, out::RESERVED) != 0 {
+            return Err(Error::ReservedNotZero {
+                offset: out::RESERVED.start,
+            });
+        }
+        if !h.indices_ok() {
+            return Err(Error::OutOfRange {
+                offset: out::NADIR.start,
+            });
+        }
+        let pts = b
+            .get(out::POINTS..b.len().saturating_sub(CRC_LEN))
+            .unwrap_or(&[]);
+        let count = pts.len() / OUTPUT_POINT_LEN;
+        // Canonical fragmentation: fragments start at multiples of the packet capacity,
+        // are full except the last, and only an empty line has an empty packet.
+        let first = usize::from(h.first);
+        let line_len = usize::from(h.line_len);
+        let expected = line_len
+            .saturating_sub(first)
+            .min(MAX_OUTPUT_POINTS_PER_PACKET);
+        if !first.is_multiple_of(MAX_OUTPUT_POINTS_PER_PACKET)
+            || (line_len > 0 && first >= line_len)
+            || (line_len == 0 && first != 0)
+        {
+            return Err(Error::OutOfRange {
+                offset: out::FIRST.start,
+            });
+        }
+        if count != expected {
+            return Err(Error::BadLength {
+                length: packet.length(),
+            });
+        }
+        for (i, rec) in pts.chunks_exact(OUTPUT_POINT_LEN).enumerate() {
+            let at = out::POINTS + i * OUTPUT_POINT_LEN;
+            OutputPointRepr::parse(rec).map_err(|e| match e {
+                Error::OutOfRange { offset } => Error::OutOfRange {
+                    offset: at + offset,
+                },
+                Error::ReservedNotZero { offset } => Error::ReservedNotZero {
+                    offset: at + offset,
+                },
+                other => other,
+            })?;
+        }
+        Ok((
+            h,
+            OutputPoints {
+                rest: pts.chunks_exact(OUTPUT_POINT_LEN),
+            },
+        ))
+    }
+}
+
+/// Checks `header` and `first`, writes the packet header and the line header of the
+/// fragment of `header`'s line that starts at `first` (a multiple of
+/// [`MAX_OUTPUT_POINTS_PER_PACKET`]); returns (points in the fragment, packet length).
+pub(super) fn begin_fragment(
+    seq: u32,
+    header: &OutputHeaderRepr,
+    first: u16,
+    out: &mut [u8],
+) -> Result<(usize, usize), EncodeError> {
+    let line_len = usize::from(header.line_len);
+    let first_us = usize::from(first);
+    if !header.indices_ok() {
+        return Err(EncodeError::OutOfRange { index: line_len });
+    }
+    if !first_us.is_multiple_of(MAX_OUTPUT_POINTS_PER_PACKET)
+        || (line_len > 0 && first_us >= line_len)
+        || (line_len == 0 && first_us != 0)
+    {
+        return Err(EncodeError::OutOfRange { index: first_us });
+    }
+    let count = (line_len - first_us.min(line_len)).min(MAX_OUTPUT_POINTS_PER_PACKET);
+    let len = output_packet_len(count);
+    if out.len() < len {
+        return Err(EncodeError::BufferTooSmall {
+            needed: len,
+            available: out.len(),
+        });
+    }
+    let len16 = u16::try_from(len).map_err(|_| EncodeError::TooManyPoints {
+        count,
+        max: MAX_OUTPUT_POINTS_PER_PACKET,
+    })?;
+    emit_header(out, PacketKind::Output, len16, seq);
+    use field::out as f;
+    let idx = |v: Option<u16>| v.unwrap_or(NO_INDEX).to_le_bytes();
+    put_bytes(out, f::INDEX.start, &header.index.to_le_bytes());
+    put_bytes(
+        out,
+        f::START_TIME.start,
+        &header.start_time_ns.to_le_bytes(),
+    );
+    put_bytes(out, f::PARAMS_HASH.start, &header.params_hash.to_le_bytes());
+    put_bytes(out, f::TRUNCATED.start, &header.truncated.to_le_bytes());
+    put_bytes(out, f::LINE_LEN.start, &header.line_len.to_le_bytes());
+    put_bytes(out, f::FIRST.start, &first.to_le_bytes());
+    put_bytes(out, f::NADIR.start, &idx(header.nadir));
+    put_bytes(out, f::LEFT.start, &idx(header.left));
+    put_bytes(out, f::RIGHT.start, &idx(header.right));
+    put_bytes(out, f::KEPT.start, &header.kept.to_le_bytes());
+    put_bytes(out, f::IRREGULAR.start, &header.irregular.to_le_bytes());
+    put_bytes(
+        out,
+        f::NO_NEIGHBOUR.start,
+        &header.no_neighbour.to_le_bytes(),
+    );
+    put_bytes(out, f::PEAKS.start, &header.peaks.to_le_bytes());
+    put_bytes(out, f::RESERVED.start, &0u16.to_le_bytes());
+    Ok((count, len))
+}
+
+/// Writes one output packet: the fragment of `header`'s line that starts at `first` (a
+/// multiple of [`MAX_OUTPUT_POINTS_PER_PACKET`]), taking point `i` of the line from
+/// `point(i)`. Returns the packet length. The body of
+/// [`crate::wire::StreamEncoder::encode_output_fragment`].
+pub(in crate::wire) fn emit_output_fragment(
+    seq: u32,
+    header: &OutputHeaderRepr,
+    first: u16,
+    mut point: impl FnMut(usize) -> Result<OutputPointRepr, EncodeError>,
+    out: &mut [u8],
+) -> Result<usize, EncodeError> {
+    let (_, len) = begin_fragment(seq, header, first, out)?;
+    let first_us = usize::from(first);
+    let recs = out
+        .get_mut(field::out::POINTS..len - CRC_LEN)
+        .unwrap_or(&mut [])
+        .chunks_exact_mut(OUTPUT_POINT_LEN);
+    for (k, rec) in recs.enumerate() {
+        let i = first_us + k;
+        point(i)?.emit(rec, i)?;
+    }
+    seal(out, len);
+    Ok(len)
+}
