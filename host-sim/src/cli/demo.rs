@@ -1,6 +1,6 @@
 //! `curbtrace demo [--out DIR] [--method bend|qiu]`: simulates a scene, extracts its road
 //! edges, evaluates them and writes the edges, `report.md`, `eval.json` and the pictures
-//! (SPEC §4, issue 5). Needs no input files.
+//! (docs/spec.md §4). Needs no input files.
 //!
 //! The steps after extraction live in the library
 //! ([`curbtrace_host_sim::eval::report::write_demo_outputs`]) so the end-to-end tests can

@@ -1,4 +1,4 @@
-//! The trajectory (SPEC §3): CSV `time,x,y,z,roll,pitch,heading`, GPS time in the LAS time
+//! The trajectory (docs/spec.md §3): CSV `time,x,y,z,roll,pitch,heading`, GPS time in the LAS time
 //! base, scanner origin in the LAS CRS, angles in degrees, heading clockwise from grid north.
 //! Interpolated at a point's time: positions linearly, heading along the shorter arc.
 
@@ -161,7 +161,7 @@ pub enum TrajectoryError {
     },
 }
 
-/// The columns a trajectory CSV must have (SPEC §3), in the header's spelling.
+/// The columns a trajectory CSV must have (docs/spec.md §3), in the header's spelling.
 pub const COLUMNS: [&str; 7] = ["time", "x", "y", "z", "roll", "pitch", "heading"];
 
 /// Fewer than this fraction of the points inside the trajectory's time range is taken as a
@@ -194,7 +194,7 @@ impl Coverage {
 }
 
 impl Trajectory {
-    /// Reads the CSV of SPEC §3: a header naming at least `time,x,y,z,roll,pitch,heading`
+    /// Reads the CSV of docs/spec.md §3: a header naming at least `time,x,y,z,roll,pitch,heading`
     /// (any order, surrounding spaces and case ignored, extra columns ignored), then one
     /// sample per line. Blank lines and lines starting with `#` are skipped.
     pub fn read_csv(path: &Path) -> Result<Trajectory, TrajectoryError> {
