@@ -9,13 +9,14 @@ use std::path::PathBuf;
 /// Arguments of `curbtrace simulate`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scene: kawasaki, sapporo, curvy or tiny.
+    /// Scene: kawasaki, sapporo, curvy, tiny, or random (a street drawn from the seed).
     #[arg(long)]
     pub scene: String,
     /// Output directory (created if missing).
     #[arg(short = 'o', long = "out")]
     pub out: PathBuf,
-    /// Seed for noise and scene details (weeds, leaves, walls, jitter).
+    /// Seed for noise and scene details (weeds, leaves, walls, jitter); for `random`, the
+    /// whole street.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Vehicle speed in km/h (default: the scene's).
@@ -25,7 +26,10 @@ pub struct Args {
 
 /// Runs `curbtrace simulate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let spec = simulate::scene_by_name(&args.scene)?;
+    let spec = simulate::scene_for(&args.scene, args.seed)?;
+    if !spec.description.is_empty() {
+        println!("{}", spec.description);
+    }
     let progress = std::io::stderr().is_terminal();
     let s = simulate::run(&spec, args.seed, args.speed, &args.out, progress)
         .with_context(|| format!("simulating scene {}", args.scene))?;

@@ -2,7 +2,7 @@
 //! lengths, gaps and outside pieces, and [`evaluate`], which fills them.
 
 use super::matching::{nearest, sample_polyline, segment_tree, to_local};
-use super::{EvalError, EvalParams};
+use super::{check_params, EvalError, EvalParams};
 use crate::model::{Category, EdgeLine, Side};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -171,20 +171,6 @@ fn merge(mut a: Accs, b: Accs) -> Accs {
         x.add(y);
     }
     a
-}
-
-fn check_params(p: &EvalParams) -> Result<(), EvalError> {
-    for (name, value) in [
-        ("buffer_m", p.buffer_m),
-        ("sample_step_m", p.sample_step_m),
-        ("min_gap_m", p.min_gap_m),
-        ("max_attribution_m", p.max_attribution_m),
-    ] {
-        if !(value.is_finite() && value > 0.0) {
-            return Err(EvalError::BadParam { name, value });
-        }
-    }
-    Ok(())
 }
 
 /// Scores `extracted` against `reference` (docs/spec.md §5; see the module docs for the exact

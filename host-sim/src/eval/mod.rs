@@ -51,9 +51,11 @@ mod matching;
 mod metrics;
 pub mod report;
 mod table;
+pub mod worst;
 
 pub use metrics::{evaluate, CategoryMetrics, EvalReport, Metrics, SideMetrics};
 pub use table::category_title;
+pub use worst::{worst_place, WorstKind, WorstPlace};
 
 use serde::Serialize;
 
@@ -102,6 +104,21 @@ pub enum EvalError {
         /// Index of the line in its slice.
         index: usize,
     },
+}
+
+/// Checks that every parameter is a positive finite number.
+pub(crate) fn check_params(p: &EvalParams) -> Result<(), EvalError> {
+    for (name, value) in [
+        ("buffer_m", p.buffer_m),
+        ("sample_step_m", p.sample_step_m),
+        ("min_gap_m", p.min_gap_m),
+        ("max_attribution_m", p.max_attribution_m),
+    ] {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(EvalError::BadParam { name, value });
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

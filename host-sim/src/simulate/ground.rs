@@ -22,7 +22,8 @@
 
 /// Distance from a toe within which the height is evaluated analytically, metres.
 pub const NEAR_M: f64 = 1.6;
-/// Bound on the slope of the smooth part of the ground (grade + crown + sidewalk slope).
+/// Least bound on the slope of the smooth part of the ground (grade + crown + sidewalk
+/// slope); steeper scenes (grades to 6 %, gutters) raise it, see [`Ground::max_slope`].
 pub const MAX_SLOPE: f64 = 0.1;
 /// Raster cell size, metres.
 const CELL_M: f64 = 0.25;
@@ -42,6 +43,12 @@ pub struct CurbShape {
     pub walk_slope: f64,
     /// Road cross slope, falling towards the curb.
     pub cross_slope: f64,
+    /// The top edge is a straight 45° chamfer of `top_radius_m` instead of a round.
+    pub chamfer: bool,
+    /// Width of a gutter channel in front of the curb, metres (0: none).
+    pub gutter_m: f64,
+    /// Cross slope of the gutter channel, falling towards the toe (steeper than the road).
+    pub gutter_slope: f64,
 }
 
 impl Default for CurbShape {
@@ -52,6 +59,9 @@ impl Default for CurbShape {
             ramp_m: 0.8,
             walk_slope: 0.015,
             cross_slope: 0.02,
+            chamfer: false,
+            gutter_m: 0.0,
+            gutter_slope: 0.0,
         }
     }
 }
@@ -146,16 +156,27 @@ pub struct Ground {
     cand: Vec<u32>,
     /// Largest step anywhere (max sidewalk height) plus margin, for safe marching.
     h_max: f64,
+    /// Bound on the slope of the smooth ground, for safe marching.
+    max_slope: f64,
 }
 
 /// The curb profile above the road at signed distance `s` (> 0) from the toe.
 #[inline]
 pub fn step_profile(shape: &CurbShape, s: f64, hc: f64, hw: f64) -> f64 {
-    if s <= 0.0 || hc <= 0.0 {
-        return if s <= 0.0 { 0.0 } else { hw.max(0.0) };
+    if s <= 0.0 {
+        return 0.0;
+    }
+    if hc <= 0.0 {
+        // No lip: the ramp (or flush sidewalk) rises straight from the toe, where the
+        // road's cross slope meets it.
+        let ramp = (s / shape.ramp_m).clamp(0.0, 1.0);
+        return hw.max(0.0) * ramp + shape.walk_slope * s.min(6.0);
     }
     let b = shape.batter_ratio * hc;
     let r = shape.top_radius_m.min(0.4 * hc);
+    if shape.chamfer {
+        return chamfer_profile(shape, s, hc, hw, b, r);
+    }
     // The face rises at angle alpha; a fillet of radius r tangent to face and top has its
     // tangent points T = r·tan(alpha/2) from the corner (b, hc) along each line, with
     // tan(alpha/2) = hc / (L + b) and cos alpha = b / L for the face length L.
@@ -170,6 +191,23 @@ pub fn step_profile(shape: &CurbShape, s: f64, hc: f64, hw: f64) -> f64 {
         hc - r + (r * r - ds * ds).max(0.0).sqrt()
     } else {
         let u = s - sc;
+        let ramp = (u / shape.ramp_m).clamp(0.0, 1.0);
+        hc + (hw - hc).max(0.0) * ramp + shape.walk_slope * u.min(6.0)
+    }
+}
+
+/// [`step_profile`] with a straight 45° chamfer of `r` at the top edge.
+fn chamfer_profile(shape: &CurbShape, s: f64, hc: f64, hw: f64, b: f64, r: f64) -> f64 {
+    // The face rises from (0, 0) to (b, hc); the chamfer cuts from the face point r below
+    // the top to the top point r behind the corner.
+    let (fs, fz) = (b * (hc - r) / hc, hc - r);
+    let ts = b + r;
+    if s < fs {
+        hc * s / b.max(1e-12)
+    } else if s < ts {
+        fz + (hc - fz) * (s - fs) / (ts - fs)
+    } else {
+        let u = s - ts;
         let ramp = (u / shape.ramp_m).clamp(0.0, 1.0);
         hc + (hw - hc).max(0.0) * ramp + shape.walk_slope * u.min(6.0)
     }
@@ -195,7 +233,12 @@ impl Seg {
     #[inline]
     fn height_above_base(&self, shape: &CurbShape, t: f64, s: f64) -> f64 {
         if s <= 0.0 {
-            shape.cross_slope * (-s).min(self.crown_m)
+            let road = |d: f64| shape.cross_slope * d.min(self.crown_m);
+            if -s < shape.gutter_m {
+                road(shape.gutter_m) - shape.gutter_slope * (shape.gutter_m + s)
+            } else {
+                road(-s)
+            }
         } else {
             let hc = self.hc[0] + (self.hc[1] - self.hc[0]) * t;
             let hw = self.hw[0] + (self.hw[1] - self.hw[0]) * t;
@@ -356,7 +399,17 @@ impl Ground {
             near,
             cand,
             h_max: h_max + 0.05,
+            max_slope: Self::max_slope(&shape, &base),
         }
+    }
+
+    /// A bound on the slope of the smooth ground for `shape` and `base`: grade, undulation,
+    /// the steeper of cross slope and gutter, and the sidewalk slope; at least [`MAX_SLOPE`].
+    pub fn max_slope(shape: &CurbShape, base: &Base) -> f64 {
+        let grade = base.grade_x.hypot(base.grade_y);
+        let wave = base.wave_m * std::f64::consts::TAU * (1.0 / 173.0 + 1.0 / 211.0);
+        let across = shape.cross_slope.max(shape.gutter_slope) + shape.walk_slope;
+        MAX_SLOPE.max(1.2 * (grade + wave + across))
     }
 
     /// Bounds `[xmin, ymin, xmax, ymax]` of the field.
@@ -429,7 +482,7 @@ impl Ground {
         let descent = -d[2];
         // A ray climbing faster than the ground can never meet it once above.
         let min_step = 0.04 / dxy.max(1e-3);
-        let rate = descent + MAX_SLOPE * dxy;
+        let rate = descent + self.max_slope * dxy;
         let mut t = t0;
         let g_at = |t: f64| -> Option<f64> {
             let p = [o[0] + d[0] * t, o[1] + d[1] * t, o[2] + d[2] * t];

@@ -69,7 +69,7 @@ use std::time::Instant;
 #[derive(Debug, thiserror::Error)]
 pub enum SimError {
     /// No scene of that name.
-    #[error("unknown scene {name:?}; valid scenes: {}", SCENE_NAMES.join(", "))]
+    #[error("unknown scene {name:?}; valid scenes: {}, random", SCENE_NAMES.join(", "))]
     UnknownScene {
         /// The name asked for.
         name: String,
@@ -98,6 +98,16 @@ pub enum SimError {
 /// A built-in scene by name, or an error listing the valid names.
 pub fn scene_by_name(name: &str) -> Result<SceneSpec, SimError> {
     SceneSpec::by_name(name).ok_or_else(|| SimError::UnknownScene { name: name.into() })
+}
+
+/// A named scene, or for `random` the random street of `seed`
+/// ([`scenes::random::random`]).
+pub fn scene_for(name: &str, seed: u64) -> Result<SceneSpec, SimError> {
+    if name == "random" {
+        Ok(scenes::random::random(seed))
+    } else {
+        scene_by_name(name)
+    }
 }
 
 /// A finished simulation in memory (scene-local coordinates for points and trajectory).
@@ -195,7 +205,7 @@ pub fn simulate(
     let dirs = scanner::mount_directions(&cfg);
     let own: Vec<bool> = dirs
         .iter()
-        .map(|&d| scanner::hits_own_vehicle(d, cfg.height_m))
+        .map(|&d| scanner::hits_own_vehicle(d, cfg.height_m, &cfg.body))
         .collect();
     let lines = ((drive.scan.1 - drive.scan.0) * cfg.line_rate_hz).round() as usize;
     let bar = progress.then(|| {

@@ -26,7 +26,7 @@ use crate::io::trajectory::{Pose, Trajectory};
 use rand::Rng;
 use rand_distr::StandardNormal;
 
-pub use super::scene::ScannerConfig;
+pub use super::scene::{ScannerConfig, VehicleBody};
 
 /// Body axes (forward, left, up) in world coordinates for a pose.
 pub fn body_axes(heading_deg: f64, pitch_deg: f64, roll_deg: f64) -> [[f64; 3]; 3] {
@@ -88,12 +88,12 @@ pub fn mount_directions(cfg: &ScannerConfig) -> Vec<[f64; 3]> {
 }
 
 /// Whether a body-frame direction from the scanner hits the vehicle itself: such pulses
-/// give no return. The scanner head sits on a rear platform 0.3 m behind the body and 0.5 m
-/// above its roof; the body is a box 4.5 m long and 1.9 m wide down to the ground. This
-/// shades a narrow strip of road about 3.5 m to the right of the path, as real rigs do.
-pub fn hits_own_vehicle(d: [f64; 3], height_m: f64) -> bool {
-    let lo = [0.3, -0.95, -height_m];
-    let hi = [4.8, 0.95, -0.5];
+/// give no return. The body is the box of [`VehicleBody`] down to the ground; with the
+/// default mount this shades a narrow strip of road about 3.5 m to the right of the path,
+/// as real rigs do, and much more with a low pitch and a large yaw.
+pub fn hits_own_vehicle(d: [f64; 3], height_m: f64, body: &VehicleBody) -> bool {
+    let lo = [body.ahead_m.0, -body.half_width_m, -height_m];
+    let hi = [body.ahead_m.1, body.half_width_m, -body.roof_below_m];
     let mut t0 = 0.0f64;
     let mut t1 = f64::INFINITY;
     for k in 0..3 {
@@ -189,7 +189,7 @@ fn cast_pulse<R: Rng>(
             let p = [o[0] + d[0] * t, o[1] + d[1] * t];
             let n = world.ground.normal(p[0], p[1]);
             let mat = match toe {
-                Some(tc) if tc.s > 0.0 => Material::Concrete,
+                Some(tc) if tc.s > 0.0 || -tc.s < world.ground.shape.gutter_m => Material::Concrete,
                 _ => Material::Asphalt,
             };
             (t, n, mat, toe)
@@ -264,12 +264,16 @@ mod tests {
 
     #[test]
     fn own_vehicle_blocks_rays_ahead_and_down_only() {
-        assert!(hits_own_vehicle([0.7, 0.0, -0.7], 2.0));
+        assert!(hits_own_vehicle(
+            [0.7, 0.0, -0.7],
+            2.0,
+            &VehicleBody::default()
+        ));
         // The lowest pulse (back and right, 50° down) clears the body.
         let cfg = ScannerConfig::default();
         let low = mount_directions(&cfg)[cfg.pulses_per_line / 2];
-        assert!(!hits_own_vehicle(low, 2.0));
-        assert!(!hits_own_vehicle([-0.7, 0.0, -0.7], 2.0));
-        assert!(!hits_own_vehicle([0.0, 0.0, 1.0], 2.0));
+        assert!(!hits_own_vehicle(low, 2.0, &cfg.body));
+        assert!(!hits_own_vehicle([-0.7, 0.0, -0.7], 2.0, &cfg.body));
+        assert!(!hits_own_vehicle([0.0, 0.0, 1.0], 2.0, &cfg.body));
     }
 }

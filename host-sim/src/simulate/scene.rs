@@ -25,8 +25,13 @@ pub struct CurbCut {
     pub u: f64,
     /// Length of the lowered part, metres.
     pub len: f64,
-    /// Lowered curb height, metres (20–30 mm).
+    /// Lowered curb height (the lip), metres; 0 for a cut flush with the road.
     pub h: f64,
+    /// Length of the linear transition either side of the lowered part, metres.
+    pub transition_m: f64,
+    /// The sidewalk behind is lowered to the lip over the cut (a flush crossing) instead of
+    /// ramping back up to its height.
+    pub flush: bool,
 }
 
 /// A side street.
@@ -42,6 +47,44 @@ pub struct Intersection {
     pub radius: f64,
     /// How far the side street's curbs run, from the main road's curb line, metres.
     pub length: f64,
+    /// Angle between the main road (direction of increasing `u`) and the side street,
+    /// degrees, 90 for a right angle.
+    pub angle_deg: f64,
+    /// Flare of the corners: 1 for a plain circular corner; above 1 the curb first turns
+    /// on a radius `flare · radius` (a third of the turn, at most 20°), then on `radius`.
+    pub flare: f64,
+}
+
+/// What a parked vehicle is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParkedKind {
+    /// A car, 4.4 × 1.7 m, 1.5 m high.
+    Car,
+    /// A van, 5.2 × 2.0 m, 2.3 m high.
+    Van,
+}
+
+impl ParkedKind {
+    /// Length and width, metres.
+    pub fn size(self) -> (f64, f64) {
+        match self {
+            ParkedKind::Car => (4.4, 1.7),
+            ParkedKind::Van => (5.2, 2.0),
+        }
+    }
+}
+
+/// A parked vehicle placed exactly (no jitter from the seed).
+#[derive(Clone, Copy, Debug)]
+pub struct Parked {
+    /// Side of the road.
+    pub side: Side,
+    /// Centre, metres along the road.
+    pub u: f64,
+    /// Distance between the curb toe and the vehicle's side, metres.
+    pub gap_m: f64,
+    /// Car or van.
+    pub kind: ParkedKind,
 }
 
 /// A bus bay: the curb swings out by `depth` over smooth tapers.
@@ -82,6 +125,10 @@ pub struct SceneSpec {
     pub curb_h: Vec<(f64, f64, f64)>,
     /// Distance of the vehicle's path from the left curb, metres (left-hand traffic).
     pub lane_from_left_m: f64,
+    /// Lane changes `(u, new distance from the left curb)`, each over 25 m.
+    pub lane_changes: Vec<(f64, f64)>,
+    /// What was drawn, for a random street (one line); empty for the named scenes.
+    pub description: String,
     /// Sidewalk widths (left, right), metres.
     pub sidewalk_m: (f64, f64),
     /// Curb cuts.
@@ -90,8 +137,10 @@ pub struct SceneSpec {
     pub intersections: Vec<Intersection>,
     /// Bus bays.
     pub bus_bays: Vec<BusBay>,
-    /// Parked cars: side and centre `u`.
+    /// Parked cars: side and centre `u` (jittered by the seed, 0.3 m from the curb).
     pub parked_cars: Vec<(Side, f64)>,
+    /// Parked cars and vans placed exactly.
+    pub parked: Vec<Parked>,
     /// Stretches with weeds at the curb: side, from, to.
     pub weeds: Vec<(Side, f64, f64)>,
     /// Leaves per 100 m of curb.
@@ -129,6 +178,30 @@ pub struct ScannerConfig {
     pub min_range_m: f64,
     /// Maximum range, metres.
     pub max_range_m: f64,
+    /// The scanning vehicle's body, which pulses cannot pass.
+    pub body: VehicleBody,
+}
+
+/// The scanning vehicle's body relative to the scanner, a box in the body frame (forward,
+/// left, up): the head sits on a rear platform behind the body and above its roof.
+#[derive(Clone, Copy, Debug)]
+pub struct VehicleBody {
+    /// The body spans from `.0` to `.1` metres ahead of the scanner.
+    pub ahead_m: (f64, f64),
+    /// Half the body's width, metres.
+    pub half_width_m: f64,
+    /// How far the roof lies below the scanner origin, metres.
+    pub roof_below_m: f64,
+}
+
+impl Default for VehicleBody {
+    fn default() -> Self {
+        VehicleBody {
+            ahead_m: (0.3, 4.8),
+            half_width_m: 0.95,
+            roof_below_m: 0.5,
+        }
+    }
 }
 
 impl Default for ScannerConfig {
@@ -144,6 +217,7 @@ impl Default for ScannerConfig {
             outlier_rate: 2e-4,
             min_range_m: 1.5,
             max_range_m: 120.0,
+            body: VehicleBody::default(),
         }
     }
 }
@@ -200,24 +274,29 @@ impl SceneSpec {
         self.base_half_width(side, u) + self.bay_depth(side, u)
     }
 
-    /// (curb height, nominal height, category) at `u` on `side` along the main road.
+    /// (curb height, sidewalk height, category) at `u` on `side` along the main road.
     pub(super) fn curb_at(&self, side: Side, u: f64) -> (f64, f64, Category) {
         let nominal = interp(&self.curb_h, u, side);
         let mut h = nominal;
+        let mut walk = nominal;
         let mut cat = Category::Curb;
         for c in self.curb_cuts.iter().filter(|c| c.side == side) {
-            // 1 m linear ramps either side of the lowered part.
+            // Linear transitions either side of the lowered part.
             let x = (u - c.u).abs() - c.len / 2.0;
-            let f = (1.0 - x).clamp(0.0, 1.0);
+            let f = (1.0 - x / c.transition_m).clamp(0.0, 1.0);
             if f > 0.0 {
-                h = h.min(nominal - (nominal - c.h) * f);
+                let lowered = nominal - (nominal - c.h) * f;
+                h = h.min(lowered);
+                if c.flush {
+                    walk = walk.min(lowered);
+                }
                 cat = Category::CurbCut;
             }
         }
         if self.bay_depth(side, u) > 1e-6 {
             cat = Category::BusBay;
         }
-        (h, nominal, cat)
+        (h, walk, cat)
     }
 
     /// The toe lines in road coordinates `(u, e)` with `e` measured outward on `side`,
@@ -243,6 +322,10 @@ impl SceneSpec {
         };
         let mut u = self.u_range.0;
         for x in &xs {
+            if x.angle_deg != 90.0 || x.flare != 1.0 {
+                u = self.oblique_corners(side, x, u, &mut cur, &mut out);
+                continue;
+            }
             let a = x.width / 2.0;
             let r = x.radius;
             let u_end = x.u - a - r;
@@ -288,6 +371,121 @@ impl SceneSpec {
         out.push(cur);
         out
     }
+
+    /// A side street at any angle and flare (see [`Intersection`]): continues `cur` on the
+    /// main curb from `u` up to the first corner, round it and up the side street, pushes
+    /// that piece to `out`, starts the next piece at the side street's far end, back
+    /// round the second corner; returns where the main curb resumes.
+    fn oblique_corners(
+        &self,
+        side: Side,
+        x: &Intersection,
+        u: f64,
+        cur: &mut Vec<ToeVertex>,
+        out: &mut Vec<Vec<ToeVertex>>,
+    ) -> f64 {
+        const STEP: f64 = 0.25;
+        let phi = x.angle_deg.to_radians();
+        let (sn, cs) = phi.sin_cos();
+        let a = x.width / 2.0;
+        let w = self.half_width_at(side, x.u);
+        let (_, hn, _) = self.curb_at(side, x.u);
+        let cat = Category::Intersection;
+        // Side street direction and the normal towards increasing u, in (u, e).
+        let d = [cs, sn];
+        let n = [sn, -cs];
+        let p1 = [x.u - a * n[0], w - a * n[1]];
+        let p2 = [x.u + a * n[0], w + a * n[1]];
+        let beta = if x.flare > 1.0 {
+            (phi / 3.0).min(20f64.to_radians())
+        } else {
+            0.0
+        };
+        // Corner 1: from heading 0 turning left by phi; its start on the main curb is
+        // where the end lands on curb line 1.
+        let arcs1 = [(x.flare * x.radius, beta), (x.radius, phi - beta)];
+        let (pts1, e1) = turtle(0.0, &arcs1);
+        let u1 = p1[0] - e1[0] + (w + e1[1] - p1[1]) * cs / sn;
+        let straight_to = |cur: &mut Vec<ToeVertex>, u0: f64, u1: f64| {
+            let k = ((u1 - u0) / STEP).ceil().max(1.0) as usize;
+            for i in 0..=k {
+                let uu = u0 + (u1 - u0) * i as f64 / k as f64;
+                let (h, hw, c) = self.curb_at(side, uu);
+                cur.push(([uu, self.half_width_at(side, uu)], h, hw, c));
+            }
+        };
+        straight_to(cur, u, u1);
+        for p in &pts1 {
+            cur.push(([u1 + p[0], w + p[1]], hn, hn, cat));
+        }
+        let end1 = [u1 + e1[0], w + e1[1]];
+        let t1 = (w + x.length - end1[1]) / sn;
+        let m1 = (t1 / STEP).ceil().max(1.0) as usize;
+        for i in 1..=m1 {
+            let t = t1 * i as f64 / m1 as f64;
+            cur.push(([end1[0] + d[0] * t, end1[1] + d[1] * t], hn, hn, cat));
+        }
+        out.push(std::mem::take(cur));
+        // Corner 2, built from the main curb backwards (heading pi, turning right by
+        // pi - phi), emitted from the side street's far end.
+        let psi = PI - phi;
+        let beta2 = if x.flare > 1.0 {
+            (psi / 3.0).min(20f64.to_radians())
+        } else {
+            0.0
+        };
+        let arcs2 = [(x.flare * x.radius, -beta2), (x.radius, -(psi - beta2))];
+        let (pts2, e2) = turtle(PI, &arcs2);
+        let u2 = p2[0] - e2[0] + (w + e2[1] - p2[1]) * cs / sn;
+        let end2 = [u2 + e2[0], w + e2[1]];
+        let t2 = (w + x.length - end2[1]) / sn;
+        let m2 = (t2 / STEP).ceil().max(1.0) as usize;
+        for i in 0..m2 {
+            let t = t2 * (m2 - i) as f64 / m2 as f64;
+            cur.push(([end2[0] + d[0] * t, end2[1] + d[1] * t], hn, hn, cat));
+        }
+        // The arc's points run from the main curb outwards: reversed, without the point on
+        // the main curb (the straight that follows starts there).
+        cur.push((end2, hn, hn, cat));
+        for p in pts2.iter().rev().skip(1) {
+            cur.push(([u2 + p[0], w + p[1]], hn, hn, cat));
+        }
+        u2
+    }
+
+    /// Where the curbs of side street `x` leave the main curb, `u` either side: the
+    /// extent of the mouth including the corners.
+    pub fn mouth(&self, x: &Intersection) -> (f64, f64) {
+        let sn = x.angle_deg.to_radians().sin();
+        let cot = x.angle_deg.to_radians().cos() / sn;
+        // The flared part turns at most 20° on its larger radius before the corner proper.
+        let flare = (x.flare - 1.0).max(0.0) * x.radius * 20f64.to_radians().sin();
+        let reach = x.width / 2.0 / sn + (x.radius + flare) * (1.0 + cot.abs()) + 1.0;
+        (x.u - reach, x.u + reach)
+    }
+}
+
+/// Points every 0.1 m along a chain of circular arcs `(radius, signed turn in radians,
+/// positive to the left)` starting at the origin with heading `h0` (radians from +u
+/// towards +e); the start itself is not included. Returns the points and the end.
+fn turtle(h0: f64, arcs: &[(f64, f64)]) -> (Vec<[f64; 2]>, [f64; 2]) {
+    let (mut p, mut h) = ([0.0, 0.0], h0);
+    let mut pts = Vec::new();
+    for &(r, turn) in arcs {
+        if turn == 0.0 || r <= 0.0 {
+            continue;
+        }
+        let s = turn.signum();
+        let c = [p[0] - s * r * h.sin(), p[1] + s * r * h.cos()];
+        let k = ((r * turn.abs()) / 0.1).ceil().max(1.0) as usize;
+        for i in 1..=k {
+            let a = h + turn * i as f64 / k as f64;
+            pts.push([c[0] + s * r * a.sin(), c[1] - s * r * a.cos()]);
+        }
+        h += turn;
+        p = *pts.last().unwrap_or(&p);
+    }
+    (pts, p)
 }
 
 /// A toe vertex in road coordinates `(u, e)` with curb height, sidewalk height, category.

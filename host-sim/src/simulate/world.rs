@@ -6,7 +6,7 @@
 use super::centerline::Centerline;
 use super::ground::{Ground, ToeLine};
 use super::prims::{Material, Objects, Prim, Shape};
-use super::scene::{smooth01, SceneSpec};
+use super::scene::{smooth01, ParkedKind, SceneSpec};
 use crate::model::Side;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -34,7 +34,7 @@ impl World {
     /// parked cars on its own side with smooth 20 m transitions (a calm lane change).
     pub fn lane_v(&self, u: f64) -> f64 {
         let s = &self.spec;
-        let lane = s.base_half_width(Side::Left, u) - s.lane_from_left_m;
+        let lane = s.base_half_width(Side::Left, u) - self.lane_from_left(u);
         let mut v = lane;
         for &(side, uc) in &s.parked_cars {
             if side != Side::Left {
@@ -53,7 +53,56 @@ impl World {
             };
             v = v.min(lane + (need - lane) * f);
         }
-        v
+        if s.parked.is_empty() {
+            return v;
+        }
+        // Vehicles on either side push the path away from them; between two it takes the
+        // middle; it never comes nearer than 1.2 m to a curb.
+        let mut lo = f64::NEG_INFINITY;
+        for p in &s.parked {
+            let (len, wid) = p.kind.size();
+            let x = (u - p.u).abs() - len / 2.0 - 2.0;
+            let f = if x <= 0.0 {
+                1.0
+            } else {
+                1.0 - smooth01(x / 20.0)
+            };
+            if f <= 0.0 {
+                continue;
+            }
+            match p.side {
+                Side::Left => {
+                    let need =
+                        s.base_half_width(Side::Left, p.u) - p.gap_m - wid - PASS_CLEARANCE_M;
+                    if need < lane {
+                        v = v.min(lane + (need - lane) * f);
+                    }
+                }
+                Side::Right => {
+                    let need =
+                        -(s.base_half_width(Side::Right, p.u) - p.gap_m - wid) + PASS_CLEARANCE_M;
+                    if need > lane {
+                        lo = lo.max(lane + (need - lane) * f);
+                    }
+                }
+            }
+        }
+        let v = if lo > v { 0.5 * (lo + v) } else { v };
+        let (l, r) = (
+            s.base_half_width(Side::Left, u) - 1.2,
+            -(s.base_half_width(Side::Right, u) - 1.2),
+        );
+        v.clamp(r.min(l), l)
+    }
+
+    /// The lane's distance from the left curb at `u`, with the scene's lane changes.
+    fn lane_from_left(&self, u: f64) -> f64 {
+        let s = &self.spec;
+        let mut l = s.lane_from_left_m;
+        for &(uc, to) in &s.lane_changes {
+            l += (to - l) * smooth01((u - uc) / 25.0);
+        }
+        l
     }
 
     /// Builds a scene's world.
@@ -119,9 +168,15 @@ impl World {
         let mut prims: Vec<Prim> = Vec::new();
 
         let in_side_street = |side: Side, u: f64, pad: f64| {
-            spec.intersections
-                .iter()
-                .any(|x| x.side == side && (u - x.u).abs() < x.width / 2.0 + pad)
+            spec.intersections.iter().any(|x| {
+                x.side == side
+                    && if x.angle_deg == 90.0 && x.flare == 1.0 {
+                        (u - x.u).abs() < x.width / 2.0 + pad
+                    } else {
+                        let (a, b) = spec.mouth(x);
+                        u > a - pad && u < b + pad
+                    }
+            })
         };
         // Walls along each side: building fronts, block walls, or open lots.
         for side in [Side::Left, Side::Right] {
@@ -147,8 +202,13 @@ impl World {
                     let mid = 0.5 * (a + e);
                     let blocked = spec.intersections.iter().any(|x| {
                         x.side == side
-                            && mid > x.u - x.width / 2.0 - sw - 1.0
-                            && mid < x.u + x.width / 2.0 + sw + 1.0
+                            && if x.angle_deg == 90.0 && x.flare == 1.0 {
+                                mid > x.u - x.width / 2.0 - sw - 1.0
+                                    && mid < x.u + x.width / 2.0 + sw + 1.0
+                            } else {
+                                let (a, b) = spec.mouth(x);
+                                mid > a - sw - 1.0 && mid < b + sw + 1.0
+                            }
                     });
                     if height > 0.0 && !blocked {
                         let off = (spec.base_half_width(side, mid) + sw)
@@ -172,6 +232,29 @@ impl World {
             // Walls along the side streets.
             for x in spec.intersections.iter().filter(|x| x.side == side) {
                 let w = spec.base_half_width(side, x.u);
+                if x.angle_deg != 90.0 || x.flare != 1.0 {
+                    let (sn, cs) = x.angle_deg.to_radians().sin_cos();
+                    for k in [-(x.width / 2.0 + sw + 0.15), x.width / 2.0 + sw + 0.15] {
+                        let base = [x.u + k * sn, w - k * cs];
+                        let at = |t: f64| center.map(base[0] + cs * t, sgn * (base[1] + sn * t));
+                        let mut t0 = (w + sw - base[1]) / sn;
+                        let t_end = (w + x.length - base[1]) / sn;
+                        while t0 < t_end {
+                            let t1 = t0 + 2.0;
+                            let mid = at(0.5 * (t0 + t1));
+                            prims.push(wall_box(
+                                at(t0),
+                                at(t1),
+                                0.3,
+                                gz(mid) - 0.3,
+                                8.3,
+                                Material::Wall,
+                            ));
+                            t0 = t1;
+                        }
+                    }
+                    continue;
+                }
                 for du in [-(x.width / 2.0 + sw + 0.15), x.width / 2.0 + sw + 0.15] {
                     let mut e0 = w + sw;
                     while e0 < w + x.length {
@@ -217,55 +300,25 @@ impl World {
             }
         }
 
-        // Parked cars at the curb.
+        // Parked cars at the curb, then the exactly placed cars and vans.
         for &(side, uc) in &spec.parked_cars {
-            let sgn = if side == Side::Left { 1.0 } else { -1.0 };
             let uc = uc + rng.gen_range(-0.5..0.5);
             let gap = CAR_GAP + rng.gen_range(-0.1..0.1);
-            let e = spec.half_width_at(side, uc) - gap - CAR_W / 2.0;
-            let c = center.map(uc, sgn * e);
-            let (_, dir) = center.pose(uc);
-            let cs = [dir.cos(), dir.sin()];
-            let at = |du: f64, dv: f64| {
-                [
-                    c[0] + du * cs[0] - dv * cs[1],
-                    c[1] + du * cs[1] + dv * cs[0],
-                ]
-            };
-            let mut z = f64::INFINITY;
-            for (du, dv) in [(1.35, 0.75), (1.35, -0.75), (-1.35, 0.75), (-1.35, -0.75)] {
-                z = z.min(gz(at(du, dv)));
-            }
-            prims.push(Prim {
-                shape: Shape::RoundBox {
-                    c: [c[0], c[1], z + 0.2 + 0.38],
-                    half: [CAR_LEN / 2.0, CAR_W / 2.0, 0.38],
-                    cs,
-                    r: 0.15,
-                },
-                material: Material::Car,
-            });
-            let cab = at(-0.3, 0.0);
-            prims.push(Prim {
-                shape: Shape::RoundBox {
-                    c: [cab[0], cab[1], z + 0.95 + 0.26],
-                    half: [1.2, 0.76, 0.28],
-                    cs,
-                    r: 0.2,
-                },
-                material: Material::Glass,
-            });
-            for (du, dv) in [(1.35, 0.72), (1.35, -0.72), (-1.35, 0.72), (-1.35, -0.72)] {
-                let p = at(du, dv);
-                prims.push(Prim {
-                    shape: Shape::Box {
-                        c: [p[0], p[1], z + 0.3],
-                        half: [0.31, 0.1, 0.31],
-                        cs,
-                    },
-                    material: Material::Tyre,
-                });
-            }
+            parked_prims(
+                &spec,
+                &center,
+                &gz,
+                side,
+                uc,
+                gap,
+                ParkedKind::Car,
+                &mut prims,
+            );
+        }
+        for p in &spec.parked {
+            parked_prims(
+                &spec, &center, &gz, p.side, p.u, p.gap_m, p.kind, &mut prims,
+            );
         }
 
         // Weeds: clumps of thin stems growing in the joint at the curb toe.
@@ -339,6 +392,93 @@ impl World {
             ground,
             objects,
         }
+    }
+}
+
+/// The primitives of a parked vehicle on `side` centred at `uc`, `gap` from the curb.
+#[allow(clippy::too_many_arguments)]
+fn parked_prims(
+    spec: &SceneSpec,
+    center: &Centerline,
+    gz: &dyn Fn([f64; 2]) -> f64,
+    side: Side,
+    uc: f64,
+    gap: f64,
+    kind: ParkedKind,
+    prims: &mut Vec<Prim>,
+) {
+    let sgn = if side == Side::Left { 1.0 } else { -1.0 };
+    let (len, w) = kind.size();
+    let e = spec.half_width_at(side, uc) - gap - w / 2.0;
+    let c = center.map(uc, sgn * e);
+    let (_, dir) = center.pose(uc);
+    let cs = [dir.cos(), dir.sin()];
+    let at = |du: f64, dv: f64| {
+        [
+            c[0] + du * cs[0] - dv * cs[1],
+            c[1] + du * cs[1] + dv * cs[0],
+        ]
+    };
+    if kind == ParkedKind::Van {
+        let mut z = f64::INFINITY;
+        for (du, dv) in [(1.9, 0.9), (1.9, -0.9), (-1.9, 0.9), (-1.9, -0.9)] {
+            z = z.min(gz(at(du, dv)));
+        }
+        prims.push(Prim {
+            shape: Shape::RoundBox {
+                c: [c[0], c[1], z + 0.22 + 0.98],
+                half: [len / 2.0, w / 2.0, 0.98],
+                cs,
+                r: 0.12,
+            },
+            material: Material::Car,
+        });
+        for (du, dv) in [(1.9, 0.92), (1.9, -0.92), (-1.9, 0.92), (-1.9, -0.92)] {
+            let p = at(du, dv);
+            prims.push(Prim {
+                shape: Shape::Box {
+                    c: [p[0], p[1], z + 0.33],
+                    half: [0.34, 0.11, 0.33],
+                    cs,
+                },
+                material: Material::Tyre,
+            });
+        }
+        return;
+    }
+    let mut z = f64::INFINITY;
+    for (du, dv) in [(1.35, 0.75), (1.35, -0.75), (-1.35, 0.75), (-1.35, -0.75)] {
+        z = z.min(gz(at(du, dv)));
+    }
+    prims.push(Prim {
+        shape: Shape::RoundBox {
+            c: [c[0], c[1], z + 0.2 + 0.38],
+            half: [len / 2.0, w / 2.0, 0.38],
+            cs,
+            r: 0.15,
+        },
+        material: Material::Car,
+    });
+    let cab = at(-0.3, 0.0);
+    prims.push(Prim {
+        shape: Shape::RoundBox {
+            c: [cab[0], cab[1], z + 0.95 + 0.26],
+            half: [1.2, 0.76, 0.28],
+            cs,
+            r: 0.2,
+        },
+        material: Material::Glass,
+    });
+    for (du, dv) in [(1.35, 0.72), (1.35, -0.72), (-1.35, 0.72), (-1.35, -0.72)] {
+        let p = at(du, dv);
+        prims.push(Prim {
+            shape: Shape::Box {
+                c: [p[0], p[1], z + 0.3],
+                half: [0.31, 0.1, 0.31],
+                cs,
+            },
+            material: Material::Tyre,
+        });
     }
 }
 

@@ -39,6 +39,8 @@ pub(super) fn kawasaki() -> SceneSpec {
                 u: 338.0,
                 len: 3.0,
                 h: 0.03,
+                transition_m: 1.0,
+                flush: false,
             },
         ],
         intersections: vec![
@@ -48,6 +50,8 @@ pub(super) fn kawasaki() -> SceneSpec {
                 width: 8.0,
                 radius: 6.0,
                 length: 25.0,
+                angle_deg: 90.0,
+                flare: 1.0,
             },
             Intersection {
                 side: R,
@@ -55,6 +59,8 @@ pub(super) fn kawasaki() -> SceneSpec {
                 width: 7.0,
                 radius: 5.0,
                 length: 25.0,
+                angle_deg: 90.0,
+                flare: 1.0,
             },
         ],
         bus_bays: vec![BusBay {

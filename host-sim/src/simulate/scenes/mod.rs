@@ -2,6 +2,7 @@
 
 mod curvy;
 mod kawasaki;
+pub mod random;
 mod sapporo;
 mod tiny;
 
@@ -38,11 +39,14 @@ pub(super) fn common(name: &str) -> SceneSpec {
         half_width: vec![(0.0, 5.0, 5.0)],
         curb_h: vec![(0.0, 0.2, 0.2)],
         lane_from_left_m: 2.5,
+        lane_changes: Vec::new(),
+        description: String::new(),
         sidewalk_m: (3.0, 3.0),
         curb_cuts: Vec::new(),
         intersections: Vec::new(),
         bus_bays: Vec::new(),
         parked_cars: Vec::new(),
+        parked: Vec::new(),
         weeds: Vec::new(),
         leaves_per_100m: 60.0,
         pole_spacing_m: 30.0,
@@ -62,5 +66,7 @@ pub(super) fn cut(side: Side, u: f64, len: f64) -> CurbCut {
         u,
         len,
         h: 0.025,
+        transition_m: 1.0,
+        flush: false,
     }
 }

@@ -42,6 +42,8 @@ pub(super) fn sapporo() -> SceneSpec {
                 width: 7.0,
                 radius: 5.0,
                 length: 25.0,
+                angle_deg: 90.0,
+                flare: 1.0,
             },
             Intersection {
                 side: R,
@@ -49,6 +51,8 @@ pub(super) fn sapporo() -> SceneSpec {
                 width: 8.0,
                 radius: 8.0,
                 length: 25.0,
+                angle_deg: 90.0,
+                flare: 1.0,
             },
         ],
         bus_bays: Vec::new(),
