@@ -33,6 +33,25 @@ pub enum ExtractError {
         /// The cause.
         source: ReplayError,
     },
+    /// Reading the point files of a stream.
+    #[error(transparent)]
+    Source(crate::source::campaign::SourceError),
+    /// The stream's core stage.
+    #[error("{path}: {what}")]
+    Stream {
+        /// The (first) point file.
+        path: PathBuf,
+        /// The cause.
+        what: String,
+    },
+    /// No point lies within the trajectory's time range.
+    #[error("{points}: no point lies within the time range of the trajectory {trajectory}")]
+    NoCoverage {
+        /// The (first) point file.
+        points: PathBuf,
+        /// The trajectory.
+        trajectory: PathBuf,
+    },
     /// A method that is not part of this build.
     #[error("method {0:?} is not available in this build")]
     Method(String),
@@ -95,6 +114,22 @@ impl Progress {
     /// Starts a stage of `total` points.
     pub fn stage(&self, name: &'static str, total: u64) {
         if let Some(b) = &self.bar {
+            b.set_message(name);
+            b.set_length(total);
+            b.set_position(0);
+        }
+    }
+
+    /// Starts a stage over `total` bytes of input, with throughput and time left.
+    pub fn stage_bytes(&self, name: &'static str, total: u64) {
+        if let Some(b) = &self.bar {
+            b.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{msg:>10} [{bar:40}] {bytes}/{total_bytes} ({bytes_per_sec}, {eta} left)",
+                )
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+                .progress_chars("=> "),
+            );
             b.set_message(name);
             b.set_length(total);
             b.set_position(0);

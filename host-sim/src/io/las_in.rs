@@ -581,7 +581,7 @@ fn parse_raw_head(path: &Path, bytes: &[u8], file_size: u64) -> Result<RawHead, 
 }
 
 /// The CRS of a header: EPSG from the GeoTIFF projected (else geodetic) key, or the WKT VLR.
-fn header_crs(header: &las::Header) -> Option<Crs> {
+pub fn header_crs(header: &las::Header) -> Option<Crs> {
     if let Some(bytes) = header.get_wkt_crs_bytes() {
         let wkt = String::from_utf8_lossy(bytes)
             .trim_end_matches('\0')
@@ -602,14 +602,27 @@ fn header_crs(header: &las::Header) -> Option<Crs> {
     Some(Crs::Epsg(u32::from(code)))
 }
 
-/// Reads the selected points of a LAS/LAZ file as columns sorted by time.
-///
-/// `progress` is called with (points decoded so far, points in the file) after each chunk.
-pub fn read_points(
-    path: &Path,
-    opts: &ReadOptions,
-    progress: &mut dyn FnMut(u64, u64),
-) -> Result<(PointColumns, LasInfo), LasError> {
+/// What [`check_file`] learnt from a file's raw header.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CheckedHead {
+    /// LAS version `(major, minor)`.
+    pub version: (u8, u8),
+    /// Point data record format (0–10).
+    pub format: u8,
+    /// LAZ-compressed.
+    pub compressed: bool,
+    /// Points the header announces.
+    pub count: u64,
+    /// Points to reserve columns for (see [`laz_reserve_cap`]).
+    pub reserve: u64,
+    /// Bytes of the file.
+    pub file_bytes: u64,
+}
+
+/// Checks a file's header, VLRs and (for LAZ) chunk table before the `las` crate reads it:
+/// signature, sizes, offsets and counts against the file's length, and a format with GPS
+/// time. Every reader of point files calls this first.
+pub fn check_file(path: &Path) -> Result<CheckedHead, LasError> {
     let io = |source| LasError::Io {
         path: path.to_path_buf(),
         source,
@@ -673,7 +686,32 @@ pub fn read_points(
         });
     }
 
-    drop(file);
+    Ok(CheckedHead {
+        version: head.version,
+        format: head.format,
+        compressed: head.compressed,
+        count: head.count,
+        reserve,
+        file_bytes: file_size,
+    })
+}
+
+/// Reads the selected points of a LAS/LAZ file as columns sorted by time.
+///
+/// `progress` is called with (points decoded so far, points in the file) after each chunk.
+pub fn read_points(
+    path: &Path,
+    opts: &ReadOptions,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<(PointColumns, LasInfo), LasError> {
+    let checked = check_file(path)?;
+    let io = |source| LasError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let reserve = checked.reserve;
+    let file_size = checked.file_bytes;
+    let head = checked;
     let file = File::open(path).map_err(io)?;
     let las_err = |e: las::Error| las_error(path, e, "reading the header and VLRs");
     let mut reader = Reader::with_options(
