@@ -17,8 +17,9 @@ pub mod external_sort;
 pub mod files;
 pub mod las_batches;
 
-/// Points per batch handed downstream (the reader decodes in slabs of this size).
-pub const BATCH_POINTS: usize = 1 << 20;
+/// Points per batch handed downstream and per decoded slab: 2^17 points are a few LAZ
+/// chunks for the parallel decoder and about 6 MB of columns.
+pub const BATCH_POINTS: usize = 1 << 15;
 
 /// A batch of points as columns, in time order. Index `i` of every column is point `i`.
 #[derive(Clone, Debug, Default, PartialEq)]

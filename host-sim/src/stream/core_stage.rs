@@ -137,7 +137,7 @@ impl<'a> CoreStage<'a> {
     /// Runs the first `n` carried points through the core.
     fn run(&mut self, n: usize) -> Result<CoreBatch, CoreError> {
         let rest = if n < self.carry.len() {
-            let mut r = PointBatch::with_capacity(self.carry.len() - n + crate::source::BATCH_POINTS);
+            let mut r = PointBatch::with_capacity(self.carry.len() - n + super::STREAM_BATCH_POINTS);
             r.extend_from(&self.carry, n..self.carry.len());
             r
         } else {

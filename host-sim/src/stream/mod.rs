@@ -37,7 +37,7 @@ use std::time::Instant;
 pub use window::WindowParams;
 
 /// Points per batch the reader hands to the core stage.
-pub const STREAM_BATCH_POINTS: usize = BATCH_POINTS / 4;
+pub const STREAM_BATCH_POINTS: usize = BATCH_POINTS;
 
 /// What one pass over a source produced.
 struct Pass {
