@@ -4,15 +4,19 @@
 //! of its section waits for the next section: a piece of the same side and category whose
 //! first vertex lies within the stitch distance of its last vertex continues it (the two
 //! were tracked over the same margin, so they meet within a vertex spacing). A waiting
-//! piece that nothing continues is closed. The short-edge filter of §2.7 runs again on
-//! joined edges: a stub left at a boundary is as short as it looks.
+//! piece that nothing continues is closed. Pieces carry the height step per vertex, so a
+//! joined edge's curb height is the median over all of it, as in a whole-file run. The
+//! short-edge filter of §2.7 runs again on joined edges: a stub left at a boundary is as
+//! short as it looks.
 
+use crate::bend::postfilter::median;
 use crate::model::EdgeLine;
 
 /// An edge piece from one section.
 #[derive(Clone, Debug)]
 pub struct Piece {
     line: EdgeLine,
+    steps: Vec<Option<f64>>,
     open_start: bool,
     open_end: bool,
     cut: bool,
@@ -20,9 +24,10 @@ pub struct Piece {
 
 impl Piece {
     /// An edge wholly inside its section.
-    pub fn whole(line: EdgeLine) -> Self {
+    pub fn whole(line: EdgeLine, steps: Vec<Option<f64>>) -> Self {
         Self {
             line,
+            steps,
             open_start: false,
             open_end: false,
             cut: false,
@@ -30,9 +35,10 @@ impl Piece {
     }
 
     /// Part of an edge, cut at its start and/or end by the section's bounds.
-    pub fn cut(line: EdgeLine, open_start: bool, open_end: bool) -> Self {
+    pub fn cut(line: EdgeLine, steps: Vec<Option<f64>>, open_start: bool, open_end: bool) -> Self {
         Self {
             line,
+            steps,
             open_start,
             open_end,
             cut: true,
@@ -109,25 +115,32 @@ impl Merge {
     }
 
     fn close(&self, p: Piece) -> Option<EdgeLine> {
-        (!p.cut || p.line.length_m() >= self.min_length_m).then_some(p.line)
+        if !p.cut {
+            return Some(p.line);
+        }
+        if p.line.length_m() < self.min_length_m {
+            return None;
+        }
+        let mut st: Vec<f64> = p.steps.iter().flatten().copied().collect();
+        Some(EdgeLine {
+            curb_height_m: median(&mut st),
+            ..p.line
+        })
     }
 }
 
-/// `a` continued by `b`: the vertices of both, the curb height weighted by length.
+/// `a` continued by `b`: the vertices and height samples of both.
 fn join(a: &Piece, b: &Piece) -> Piece {
-    let (la, lb) = (a.line.length_m(), b.line.length_m());
-    let h = match (a.line.curb_height_m, b.line.curb_height_m) {
-        (Some(x), Some(y)) if la + lb > 0.0 => Some((x * la + y * lb) / (la + lb)),
-        (x, y) => x.or(y),
-    };
     let mut points = a.line.points.clone();
     points.extend_from_slice(&b.line.points);
+    let mut steps = a.steps.clone();
+    steps.extend_from_slice(&b.steps);
     Piece {
         line: EdgeLine {
             points,
-            curb_height_m: h,
             ..b.line.clone()
         },
+        steps,
         open_start: a.open_start,
         open_end: b.open_end,
         cut: true,
@@ -138,6 +151,10 @@ fn join(a: &Piece, b: &Piece) -> Piece {
 mod tests {
     use super::*;
     use crate::model::Side;
+
+    fn piece(x0: f64, x1: f64, side: Side, h: f64, open: (bool, bool)) -> Piece {
+        Piece::cut(line(x0, x1, side), vec![Some(h); 2], open.0, open.1)
+    }
 
     fn line(x0: f64, x1: f64, side: Side) -> EdgeLine {
         EdgeLine {
@@ -152,17 +169,19 @@ mod tests {
     #[test]
     fn pieces_meeting_at_a_boundary_become_one_edge_and_others_stay_apart() {
         let mut m = Merge::new(0.3, 3.0);
-        let a = Piece::cut(line(0.0, 9.9, Side::Left), false, true);
-        let r = Piece::cut(line(0.0, 9.9, Side::Right), false, true);
+        let a = piece(0.0, 9.9, Side::Left, 0.10, (false, true));
+        let r = piece(0.0, 9.9, Side::Right, 0.10, (false, true));
         assert!(m.push(vec![a, r], 0.0, 10.0).is_empty());
         // The left one continues 0.2 m on; the right one's continuation is 2 m away.
-        let b = Piece::cut(line(10.1, 20.0, Side::Left), true, false);
-        let c = Piece::cut(line(12.0, 12.5, Side::Right), true, false);
+        let b = piece(10.1, 20.0, Side::Left, 0.14, (true, false));
+        let c = piece(12.0, 12.5, Side::Right, 0.10, (true, false));
         let out = m.push(vec![b, c], 10.0, 20.0);
         assert_eq!(out.len(), 2, "{out:?}");
         let left = out.iter().find(|e| e.side == Side::Left).unwrap();
         assert_eq!(left.points.len(), 4);
         assert!((left.length_m() - 20.0).abs() < 1e-9);
+        // The median of the four samples 0.10, 0.10, 0.14, 0.14.
+        assert_eq!(left.curb_height_m, Some(0.12));
         // The right stub of 0.5 m is under the minimum length and dropped; the 9.9 m
         // right piece is closed on its own.
         let right = out.iter().find(|e| e.side == Side::Right).unwrap();

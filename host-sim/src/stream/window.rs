@@ -185,7 +185,11 @@ impl<'a> SectionWindow<'a> {
     /// Runs the remaining sections and closes every edge.
     pub fn finish(&mut self) -> Vec<EdgeLine> {
         if self.single() {
-            return self.extract_range(0, self.cols.len());
+            return self
+                .extract_range(0, self.cols.len())
+                .into_iter()
+                .map(|(e, _)| e)
+                .collect();
         }
         let mut out = Vec::new();
         let l = self.section_m();
@@ -207,8 +211,8 @@ impl<'a> SectionWindow<'a> {
         let hi = self.cols.t.partition_point(|&t| self.station(t) < s1 + m);
         let edges = if hi > lo { self.extract_range(lo, hi) } else { Vec::new() };
         let mut pieces = Vec::new();
-        for e in edges {
-            pieces.extend(cut_to_section(&self.route, e, s0, s1));
+        for (e, steps) in edges {
+            pieces.extend(cut_to_section(&self.route, e, steps, s0, s1));
         }
         let closed = self.merge.push(pieces, s0, s1);
         self.next += 1;
@@ -218,7 +222,7 @@ impl<'a> SectionWindow<'a> {
     }
 
     /// The bend method on the window's points `lo..hi`.
-    fn extract_range(&self, lo: usize, hi: usize) -> Vec<EdgeLine> {
+    fn extract_range(&self, lo: usize, hi: usize) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
         let c = &self.cols;
         let (glo, ghi) = (c.base + lo as u64, c.base + hi as u64);
         let cands: Vec<Candidate> = c
@@ -241,12 +245,18 @@ impl<'a> SectionWindow<'a> {
             candidates: &cands,
             trajectory: self.traj,
         };
-        bend::extract_edges(&input, &self.bend)
+        bend::extract_edges_with_steps(&input, &self.bend)
     }
 }
 
 /// The runs of an edge's vertices whose station lies in `[s0, s1)`, each as a piece.
-fn cut_to_section(route: &Route, e: EdgeLine, s0: f64, s1: f64) -> Vec<Piece> {
+fn cut_to_section(
+    route: &Route,
+    e: EdgeLine,
+    steps: Vec<Option<f64>>,
+    s0: f64,
+    s1: f64,
+) -> Vec<Piece> {
     let st: Vec<f64> = e
         .points
         .iter()
@@ -254,7 +264,7 @@ fn cut_to_section(route: &Route, e: EdgeLine, s0: f64, s1: f64) -> Vec<Piece> {
         .collect();
     let inside = |s: f64| s >= s0 && s < s1;
     if st.iter().all(|&s| inside(s)) {
-        return vec![Piece::whole(e)];
+        return vec![Piece::whole(e, steps)];
     }
     let mut out = Vec::new();
     let mut k = 0;
@@ -272,6 +282,7 @@ fn cut_to_section(route: &Route, e: EdgeLine, s0: f64, s1: f64) -> Vec<Piece> {
                 points: e.points[a..k].to_vec(),
                 ..e.clone()
             },
+            steps[a..k].to_vec(),
             a > 0,
             k < st.len(),
         ));
