@@ -33,3 +33,5 @@ pub mod proc_stats;
 pub mod qiu;
 pub mod replay;
 pub mod simulate;
+pub mod source;
+pub mod stream;

@@ -8,9 +8,9 @@ use crate::config::{Config, ConfigError};
 use crate::io::las_in::{self, LasError, LasInfo, PointColumns, ReadOptions};
 use crate::io::trajectory::{Trajectory, TrajectoryError};
 use crate::model::{Crs, EdgeLine};
+use crate::proc_stats::{peak_rss_bytes, process_cpu_s};
 use crate::replay::run::{self, KernelResults, ReplayCounters, ReplayError};
 use std::path::{Path, PathBuf};
-use crate::proc_stats::{peak_rss_bytes, process_cpu_s};
 use std::time::Instant;
 
 /// Errors of the whole extraction; every message names the file and the problem.
@@ -32,6 +32,25 @@ pub enum ExtractError {
         path: PathBuf,
         /// The cause.
         source: ReplayError,
+    },
+    /// Reading the point files of a stream.
+    #[error(transparent)]
+    Source(crate::source::campaign::SourceError),
+    /// The stream's core stage.
+    #[error("{path}: {what}")]
+    Stream {
+        /// The (first) point file.
+        path: PathBuf,
+        /// The cause.
+        what: String,
+    },
+    /// No point lies within the trajectory's time range.
+    #[error("{points}: no point lies within the time range of the trajectory {trajectory}")]
+    NoCoverage {
+        /// The (first) point file.
+        points: PathBuf,
+        /// The trajectory.
+        trajectory: PathBuf,
     },
     /// A method that is not part of this build.
     #[error("method {0:?} is not available in this build")]
@@ -95,6 +114,22 @@ impl Progress {
     /// Starts a stage of `total` points.
     pub fn stage(&self, name: &'static str, total: u64) {
         if let Some(b) = &self.bar {
+            b.set_message(name);
+            b.set_length(total);
+            b.set_position(0);
+        }
+    }
+
+    /// Starts a stage over `total` bytes of input, with throughput and time left.
+    pub fn stage_bytes(&self, name: &'static str, total: u64) {
+        if let Some(b) = &self.bar {
+            b.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{msg:>10} [{bar:40}] {bytes}/{total_bytes} ({bytes_per_sec}, {eta} left)",
+                )
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+                .progress_chars("=> "),
+            );
             b.set_message(name);
             b.set_length(total);
             b.set_position(0);

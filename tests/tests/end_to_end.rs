@@ -9,18 +9,23 @@
 use curbtrace_host_sim::config::Config;
 use curbtrace_host_sim::eval::{evaluate, EvalParams, EvalReport};
 use curbtrace_host_sim::model::{read_geojson, Category};
-use curbtrace_host_sim::pipeline::extract_file;
+use curbtrace_host_sim::pipeline::{ExtractOptions, Progress};
 use curbtrace_host_sim::simulate;
+use curbtrace_host_sim::stream::{self, WindowParams};
 use std::path::Path;
 
 fn simulate_extract_eval(scene: &str, seed: u64, dir: &Path) -> EvalReport {
     let spec = simulate::scene_by_name(scene).expect("scene exists");
     let sim = simulate::run(&spec, seed, None, dir, false).expect("simulation runs");
     assert!(sim.points > 100_000, "{scene}: only {} points", sim.points);
-    let result = extract_file(
-        &dir.join("points.laz"),
+    // The product path of `curbtrace extract`: the stream with its default window.
+    let result = stream::extract(
+        &[dir.join("points.laz")],
         &dir.join("trajectory.csv"),
         &Config::default(),
+        &ExtractOptions::default(),
+        &WindowParams::default(),
+        &Progress::hidden(),
     )
     .expect("extraction runs");
     assert!(!result.edges.is_empty(), "{scene}: no edges");

@@ -77,6 +77,18 @@ impl<'a> BendInput<'a> {
 /// outside the roadway, and returns each edge once with `method = "bend"`, its side, its
 /// median height step and a category per stretch.
 pub fn extract_edges(input: &BendInput, params: &BendParams) -> Vec<EdgeLine> {
+    extract_edges_with_steps(input, params)
+        .into_iter()
+        .map(|(e, _)| e)
+        .collect()
+}
+
+/// [`extract_edges`], with each edge's height step per vertex (see
+/// [`postfilter::to_edge_lines_with_steps`]).
+pub fn extract_edges_with_steps(
+    input: &BendInput,
+    params: &BendParams,
+) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
     let input = input.truncated();
     let route = route::Route::new(input.trajectory);
     // One index over every processed point: tracking reads the kept ones, the vehicle
@@ -101,7 +113,7 @@ pub fn extract_edges(input: &BendInput, params: &BendParams) -> Vec<EdgeLine> {
     } else {
         tracks
     };
-    postfilter::to_edge_lines(&input, &grid, &route, &tracks, params)
+    postfilter::to_edge_lines_with_steps(&input, &grid, &route, &tracks, params)
 }
 
 #[cfg(test)]

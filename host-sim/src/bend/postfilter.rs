@@ -16,8 +16,8 @@ use super::params::BendParams;
 use super::route::Route;
 use super::track::Track;
 use super::BendInput;
-use crate::replay::PointStatus;
 use crate::model::{Category, EdgeLine};
+use crate::replay::PointStatus;
 
 fn pos(input: &BendInput, p: u32) -> [f64; 3] {
     let i = p as usize;
@@ -174,7 +174,8 @@ pub fn remove_outside_roadway(_input: &BendInput, route: &Route, tracks: Vec<Tra
         .collect()
 }
 
-fn median(v: &mut [f64]) -> Option<f64> {
+/// The median of `v` (reordered in place), `None` when empty.
+pub fn median(v: &mut [f64]) -> Option<f64> {
     if v.is_empty() {
         return None;
     }
@@ -276,6 +277,22 @@ pub fn to_edge_lines(
     tracks: &[Track],
     params: &BendParams,
 ) -> Vec<EdgeLine> {
+    to_edge_lines_with_steps(input, grid, route, tracks, params)
+        .into_iter()
+        .map(|(e, _)| e)
+        .collect()
+}
+
+/// [`to_edge_lines`], with each line's height step per vertex (the samples its
+/// `curb_height_m` is the median of), so that pieces of a line joined later get the
+/// median of all their samples.
+pub fn to_edge_lines_with_steps(
+    input: &BendInput,
+    grid: &PointGrid,
+    route: &Route,
+    tracks: &[Track],
+    params: &BendParams,
+) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
     let mut out = Vec::new();
     for t in tracks {
         // Virtual vertices (ids past the points) have no scanline neighbours to refine on.
@@ -315,13 +332,16 @@ pub fn to_edge_lines(
         let runs = category_runs(&xy, &cats, params.min_category_run_m);
         for (a, b, cat) in runs {
             let mut st: Vec<f64> = steps[a..=b].iter().flatten().copied().collect();
-            out.push(EdgeLine {
-                points: xyz[a..=b].to_vec(),
-                side: t.side,
-                category: Some(cat),
-                method: Some("bend".to_string()),
-                curb_height_m: median(&mut st),
-            });
+            out.push((
+                EdgeLine {
+                    points: xyz[a..=b].to_vec(),
+                    side: t.side,
+                    category: Some(cat),
+                    method: Some("bend".to_string()),
+                    curb_height_m: median(&mut st),
+                },
+                steps[a..=b].to_vec(),
+            ));
         }
     }
     out
@@ -336,8 +356,9 @@ fn refined_pos(input: &BendInput, p: u32) -> [f64; 3] {
     if i == 0 || i + 1 >= input.x.len() {
         return here;
     }
-    let ok =
-        |j: usize| input.status[j] == Some(PointStatus::Kept) && input.scanline[j] == input.scanline[i];
+    let ok = |j: usize| {
+        input.status[j] == Some(PointStatus::Kept) && input.scanline[j] == input.scanline[i]
+    };
     if !(ok(i - 1) && ok(i + 1)) {
         return here;
     }

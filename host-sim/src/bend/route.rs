@@ -95,6 +95,72 @@ impl Route {
         Some([h.sin(), h.cos()])
     }
 
+    /// Arc length of the nearest point of the route to `(px, py)`, metres, or `None` for
+    /// an empty route.
+    pub fn station_near(&self, px: f64, py: f64) -> Option<f64> {
+        let (q, _) = self.nearest(px, py)?;
+        // The nearest point lies on a segment of the original samples: find it by position.
+        let k = self.segment_near(q)?;
+        let next = (k + 1).min(self.s.len() - 1);
+        let l = (self.x[next] - self.x[k]).hypot(self.y[next] - self.y[k]);
+        let u = if l > 0.0 {
+            ((q[0] - self.x[k]).hypot(q[1] - self.y[k]) / l).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        Some(self.s[k] + u * (self.s[next] - self.s[k]))
+    }
+
+    /// The route segment (index of its first sample) passing closest to `q`, searched among
+    /// the samples within 4 m (of arc) of the nearest kept vertex.
+    fn segment_near(&self, q: [f64; 2]) -> Option<usize> {
+        let mut best: Option<(f64, usize)> = None;
+        let mut r = 2.0 * DECIMATE_M;
+        while best.is_none() && r < 1e7 {
+            self.grid
+                .for_each_within(&self.x, &self.y, q[0], q[1], r, |k| {
+                    let d = (self.x[k] - q[0]).hypot(self.y[k] - q[1]);
+                    if best.is_none_or(|(bd, bk)| d < bd || (d == bd && k < bk)) {
+                        best = Some((d, k));
+                    }
+                });
+            r *= 4.0;
+        }
+        let (_, k0) = best?;
+        let s0 = self.s[k0];
+        let lo = self.s.partition_point(|&s| s < s0 - 4.0).saturating_sub(1);
+        let hi = self
+            .s
+            .partition_point(|&s| s <= s0 + 4.0)
+            .min(self.s.len() - 1);
+        let mut out: Option<(f64, usize)> = None;
+        for k in lo..=hi {
+            let e = (k + 1).min(self.s.len() - 1);
+            let (ax, ay, dx, dy) = (
+                self.x[k],
+                self.y[k],
+                self.x[e] - self.x[k],
+                self.y[e] - self.y[k],
+            );
+            let l2 = dx * dx + dy * dy;
+            let u = if l2 > 0.0 {
+                (((q[0] - ax) * dx + (q[1] - ay) * dy) / l2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let d = (ax + u * dx - q[0]).hypot(ay + u * dy - q[1]);
+            if out.is_none_or(|(bd, _)| d < bd) {
+                out = Some((d, k));
+            }
+        }
+        out.map(|o| o.1)
+    }
+
+    /// Arc length of the route's last sample, metres.
+    pub fn length_m(&self) -> f64 {
+        self.s.last().copied().unwrap_or(0.0)
+    }
+
     /// The nearest point of the route polyline to `(px, py)` and the forward unit vector
     /// there, or `None` for an empty route.
     pub fn nearest(&self, px: f64, py: f64) -> Option<([f64; 2], [f64; 2])> {

@@ -1,9 +1,12 @@
-//! `curbtrace extract POINTS --trajectory CSV -o EDGES.geojson` — the main job (docs/spec.md §4).
+//! `curbtrace extract POINTS... --trajectory CSV -o EDGES.geojson` — the main job
+//! (docs/spec.md §4). POINTS are LAS/LAZ files, directories or glob patterns, read as one
+//! time-ordered stream in bounded memory (`stream`).
 
 use anyhow::Context;
 use curbtrace_host_sim::config::Config;
 use curbtrace_host_sim::output;
 use curbtrace_host_sim::pipeline::{self, ExtractOptions, Method, Progress};
+use curbtrace_host_sim::stream::{self, WindowParams};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -28,9 +31,10 @@ pub enum MethodArg {
 /// Arguments of `curbtrace extract`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// LAS or LAZ point file (formats with GPS time: 1, 3, 4, 5, 6–10).
-    #[arg(required_unless_present = "print_config")]
-    pub points: Option<PathBuf>,
+    /// LAS or LAZ point files (formats with GPS time: 1, 3, 4, 5, 6–10), directories of
+    /// them or glob patterns; one campaign, ordered by time.
+    #[arg(required_unless_present = "print_config", num_args = 1..)]
+    pub points: Vec<PathBuf>,
     /// Trajectory CSV: time,x,y,z,roll,pitch,heading (GPS time in the LAS time base).
     #[arg(long, required_unless_present = "print_config")]
     pub trajectory: Option<PathBuf>,
@@ -52,6 +56,13 @@ pub struct Args {
     /// Prints the configuration in force (defaults, or --config's) as TOML and exits.
     #[arg(long)]
     pub print_config: bool,
+    /// Length of the sections of road whose edges are closed together, metres.
+    #[arg(long, default_value_t = WindowParams::default().section_m)]
+    pub section_m: f64,
+    /// Road before and after a section that its window also holds, metres (at least the
+    /// tracker's reach; see docs/benchmarks.md).
+    #[arg(long, default_value_t = WindowParams::default().margin_m)]
+    pub margin_m: f64,
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -70,8 +81,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
         return Ok(());
     }
-    let (Some(points), Some(trajectory), Some(output)) =
-        (&args.points, &args.trajectory, &args.output)
+    let (false, Some(trajectory), Some(output)) =
+        (args.points.is_empty(), &args.trajectory, &args.output)
     else {
         anyhow::bail!("POINTS, --trajectory and -o are required");
     };
@@ -87,7 +98,22 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     } else {
         Progress::hidden()
     };
-    let result = pipeline::extract_file_with(points, trajectory, &cfg, &opts, &progress)?;
+    let result = match opts.method {
+        Method::Bend => {
+            let window = WindowParams {
+                section_m: args.section_m,
+                margin_m: args.margin_m,
+            };
+            stream::extract(&args.points, trajectory, &cfg, &opts, &window, &progress)?
+        }
+        Method::Qiu => {
+            let [points] = args.points.as_slice() else {
+                anyhow::bail!("--method qiu reads one file, not {}", args.points.len());
+            };
+            qiu_size_check(points)?;
+            pipeline::extract_file_with(points, trajectory, &cfg, &opts, &progress)?
+        }
+    };
     progress.finish();
     if let (Format::Geojson, None) = (args.format, &result.crs) {
         let why = result.summary.las.no_crs.map_or_else(
@@ -97,17 +123,37 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         eprintln!(
             "warning: {}: the output has no CRS: {why} ({})",
             output.display(),
-            points.display()
+            result.summary.las.path.display()
         );
     }
     match args.format {
-        Format::Geojson => output::geojson::write_geojson(output, &result.edges, result.crs.as_ref())?,
+        Format::Geojson => {
+            output::geojson::write_geojson(output, &result.edges, result.crs.as_ref())?
+        }
         Format::Csv => output::csv::write_edges(output, &result.edges)
             .with_context(|| format!("{}: writing the edges", output.display()))?,
     }
     if !args.quiet {
         eprintln!("{}", result.summary.to_text());
         eprintln!("written            {}", output.display());
+    }
+    Ok(())
+}
+
+/// Most points `--method qiu` takes: it holds the whole file in memory (about 60 B per
+/// point at its peak).
+const QIU_MAX_POINTS: u64 = 20_000_000;
+
+/// Refuses files too large for the whole-file qiu method, naming the file and the limit.
+fn qiu_size_check(points: &std::path::Path) -> anyhow::Result<()> {
+    let head = curbtrace_host_sim::io::las_in::check_file(points)?;
+    if head.count > QIU_MAX_POINTS {
+        anyhow::bail!(
+            "{}: {} points; --method qiu holds the whole file in memory and takes at most {} (the bend method streams any size)",
+            points.display(),
+            head.count,
+            QIU_MAX_POINTS
+        );
     }
     Ok(())
 }

@@ -134,7 +134,8 @@ pub struct ReplayCounters {
 }
 
 impl ReplayCounters {
-    fn add(&mut self, o: &ReplayCounters) {
+    /// Adds `o`'s counts to these.
+    pub fn add(&mut self, o: &ReplayCounters) {
         self.points_sent += o.points_sent;
         self.scanlines += o.scanlines;
         self.kept += o.kept;
@@ -158,6 +159,8 @@ pub struct KernelResults {
     pub scanline: Vec<u32>,
     /// Seed candidates, in scanline order.
     pub candidates: Vec<Candidate>,
+    /// Scanlines numbered (the next run's numbers start here).
+    pub lines: u32,
     /// Counters.
     pub counters: ReplayCounters,
 }
@@ -341,8 +344,22 @@ pub fn run_kernel(
     params: &ReplayParams,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<KernelResults, ReplayError> {
-    let n = cols.len();
     let rule = LineRule::choose(&cols.scan_angle_deg, &cols.t, &params.line());
+    run_kernel_with_rule(cols, traj, words, params, &rule, progress)
+}
+
+/// [`run_kernel`] with the line-start rule given (a stream chooses it once, on its first
+/// batch, and keeps it).
+pub fn run_kernel_with_rule(
+    cols: &PointColumns,
+    traj: &Trajectory,
+    words: &[u32; CONFIG_WORDS],
+    params: &ReplayParams,
+    rule: &LineRule,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<KernelResults, ReplayError> {
+    let rule = *rule;
+    let n = cols.len();
     let ranges = chunks(cols, &rule, params.chunk_points);
     let mut rho = vec![0f32; n];
     let mut status = vec![None; n];
@@ -428,6 +445,7 @@ pub fn run_kernel(
         status,
         scanline,
         candidates,
+        lines: base,
         counters,
     })
 }

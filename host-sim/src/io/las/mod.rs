@@ -83,6 +83,49 @@ pub struct LasInfo {
     pub has_scan_angle: bool,
 }
 
+/// What [`check_file`] learnt from a file whose header, VLRs and (LAZ) chunk table passed
+/// every check.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CheckedHead {
+    /// LAS version `(major, minor)`.
+    pub version: (u8, u8),
+    /// Point data record format (0–10).
+    pub format: u8,
+    /// LAZ-compressed.
+    pub compressed: bool,
+    /// Points the header announces.
+    pub count: u64,
+    /// Points to reserve columns for (see [`laz_reserve_cap`]).
+    pub reserve: u64,
+    /// Bytes of the file.
+    pub file_bytes: u64,
+}
+
+/// Checks a file before the `las` crate reads it (see [`check_open_file`]): every reader of
+/// point files calls this first.
+pub fn check_file(path: &Path) -> Result<CheckedHead, LasError> {
+    let io = |source| LasError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut file = File::open(path).map_err(io)?;
+    let file_size = file.metadata().map_err(io)?.len();
+    let c = check_open_file(path, &mut file, file_size)?;
+    Ok(CheckedHead {
+        version: c.head.version,
+        format: c.head.format,
+        compressed: c.head.compressed,
+        count: c.head.count,
+        reserve: c.reserve,
+        file_bytes: file_size,
+    })
+}
+
+/// The file's CRS, or why it has none.
+pub fn header_crs(header: &las::Header) -> Result<Crs, NoCrs> {
+    crs::header_crs(header)
+}
+
 /// A file whose header, VLRs and (LAZ) chunk table passed every check: the points can be
 /// decoded.
 struct CheckedFile {
@@ -95,7 +138,7 @@ struct CheckedFile {
 /// and what it lacks, the header's consistency (with the file's size, its VLRs and extended
 /// VLRs), then the compression details. Nothing is allocated from a header field before it
 /// is checked.
-fn check_file(path: &Path, file: &mut File, file_size: u64) -> Result<CheckedFile, LasError> {
+fn check_open_file(path: &Path, file: &mut File, file_size: u64) -> Result<CheckedFile, LasError> {
     let head = header::read_head(path, file, file_size)?;
     header::check_format(path, &head)?;
     header::check_consistency(path, &head)?;
@@ -128,7 +171,7 @@ pub fn read_points(
     };
     let mut file = File::open(path).map_err(io)?;
     let file_size = file.metadata().map_err(io)?.len();
-    let checked = check_file(path, &mut file, file_size)?;
+    let checked = check_open_file(path, &mut file, file_size)?;
     drop(file);
 
     let mut reader = decode::open_reader(path, &checked.head)?;

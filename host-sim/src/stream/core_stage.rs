@@ -1,0 +1,200 @@
+//! The core stage of the stream: batches of points in time order in, the core's output per
+//! point out. Points outside the trajectory's time range are dropped and counted. Each
+//! batch is cut at its last line start; the partial line is carried into the next batch,
+//! so every scanline reaches the core whole and the output is the one of the whole-file
+//! replay (`replay::run`: a pipeline started at a line start behaves as one that has been
+//! running). The line-start rule is chosen on the first batch and kept.
+//!
+//! Without line starts (no scan angle, no `[replay] line_period_s`) the core splits lines
+//! itself, which needs the stream uncut: the points are then held until the end, up to
+//! [`UNCUT_MAX_POINTS`].
+
+use crate::io::las_in::PointColumns;
+use crate::io::trajectory::Trajectory;
+use crate::replay::line_start::LineRule;
+use crate::replay::run::{self, ReplayCounters, ReplayError, ReplayParams};
+use crate::replay::{Candidate, PointStatus};
+use crate::source::PointBatch;
+use curbtrace_core::kernel::CONFIG_WORDS;
+
+/// Most points held for a stream without line starts.
+pub const UNCUT_MAX_POINTS: usize = 20_000_000;
+
+/// Errors of the core stage.
+#[derive(Debug, thiserror::Error)]
+pub enum CoreError {
+    /// The replay through the core.
+    #[error("replay through the core: {0}")]
+    Replay(#[from] ReplayError),
+    /// A stream without line starts larger than the core stage may hold.
+    #[error("the points carry no scan angle to find scanline starts and the stream passed {UNCUT_MAX_POINTS} points; set [replay] line_period_s in the config")]
+    Uncut,
+}
+
+/// The core's output for a run of consecutive points of the stream.
+#[derive(Debug, Default)]
+pub struct CoreBatch {
+    /// Stream index of the first point.
+    pub base: u64,
+    /// World X.
+    pub x: Vec<f64>,
+    /// World Y.
+    pub y: Vec<f64>,
+    /// World Z.
+    pub z: Vec<f64>,
+    /// GPS time.
+    pub t: Vec<f64>,
+    /// ρ, degrees.
+    pub rho_deg: Vec<f32>,
+    /// Status per point.
+    pub status: Vec<Option<PointStatus>>,
+    /// Stream-wide scanline number, meaningful where the status is `Some`.
+    pub scanline: Vec<u32>,
+    /// Candidates; `point` is relative to `base`.
+    pub candidates: Vec<Candidate>,
+}
+
+/// The core stage's state between batches.
+pub struct CoreStage<'a> {
+    traj: &'a Trajectory,
+    words: [u32; CONFIG_WORDS],
+    params: ReplayParams,
+    t_range: (f64, f64),
+    rule: Option<LineRule>,
+    carry: PointBatch,
+    next_base: u64,
+    lines: u32,
+    /// Counters summed over the stream.
+    pub counters: ReplayCounters,
+    /// Points before / after the trajectory.
+    pub dropped: (u64, u64),
+    /// Points kept.
+    pub points: u64,
+}
+
+impl<'a> CoreStage<'a> {
+    /// A stage for `traj` with the core's config `words`.
+    pub fn new(traj: &'a Trajectory, words: [u32; CONFIG_WORDS], params: ReplayParams) -> Self {
+        Self {
+            traj,
+            words,
+            params,
+            t_range: traj
+                .time_range()
+                .unwrap_or((f64::INFINITY, f64::NEG_INFINITY)),
+            rule: None,
+            carry: PointBatch::default(),
+            next_base: 0,
+            lines: 0,
+            counters: ReplayCounters::default(),
+            dropped: (0, 0),
+            points: 0,
+        }
+    }
+
+    /// Takes a batch; returns the core's output for the whole lines it completes.
+    pub fn push(&mut self, b: PointBatch) -> Result<Option<CoreBatch>, CoreError> {
+        let (t0, t1) = self.t_range;
+        let lo = b.t.partition_point(|&t| t < t0);
+        let hi = b.t.partition_point(|&t| t <= t1).max(lo);
+        self.dropped.0 += lo as u64;
+        self.dropped.1 += (b.len() - hi) as u64;
+        if self.carry.is_empty() && lo == 0 && hi == b.len() {
+            self.carry = b;
+        } else {
+            self.carry.extend_from(&b, lo..hi);
+        }
+        if self.carry.is_empty() {
+            return Ok(None);
+        }
+        let rule = *self.rule.get_or_insert_with(|| {
+            LineRule::choose(
+                &self.carry.scan_angle_deg,
+                &self.carry.t,
+                &self.params.line(),
+            )
+        });
+        if !rule.flags_lines() {
+            if self.carry.len() > UNCUT_MAX_POINTS {
+                return Err(CoreError::Uncut);
+            }
+            return Ok(None);
+        }
+        // The last line start after the first point: everything before it is whole lines.
+        let c = &self.carry;
+        let cut = (1..c.len())
+            .rev()
+            .find(|&i| rule.is_start(i, &c.scan_angle_deg, &c.t));
+        match cut {
+            Some(i) => self.run(i).map(Some),
+            None => Ok(None),
+        }
+    }
+
+    /// Runs what is left at the end of the stream.
+    pub fn finish(&mut self) -> Result<Option<CoreBatch>, CoreError> {
+        if self.carry.is_empty() {
+            return Ok(None);
+        }
+        let n = self.carry.len();
+        self.run(n).map(Some)
+    }
+
+    /// Runs the first `n` carried points through the core.
+    fn run(&mut self, n: usize) -> Result<CoreBatch, CoreError> {
+        let rest = if n < self.carry.len() {
+            let mut r =
+                PointBatch::with_capacity(self.carry.len() - n + super::STREAM_BATCH_POINTS);
+            r.extend_from(&self.carry, n..self.carry.len());
+            r
+        } else {
+            PointBatch::default()
+        };
+        let mut head = std::mem::replace(&mut self.carry, rest);
+        head.x.truncate(n);
+        head.y.truncate(n);
+        head.z.truncate(n);
+        head.t.truncate(n);
+        head.intensity.truncate(n);
+        head.scan_angle_deg.truncate(n);
+        let cols = PointColumns {
+            x: head.x,
+            y: head.y,
+            z: head.z,
+            t: head.t,
+            intensity: head.intensity,
+            scan_angle_deg: head.scan_angle_deg,
+        };
+        let rule = self.rule.unwrap_or(LineRule::None);
+        let k =
+            run::run_kernel_with_rule(&cols, self.traj, &self.words, &self.params, &rule, &|_| {})?;
+        let base = self.next_base;
+        let lines = self.lines;
+        self.next_base += n as u64;
+        self.lines = self.lines.saturating_add(k.lines);
+        self.points += n as u64;
+        self.counters.add(&k.counters);
+        let mut scanline = k.scanline;
+        if lines > 0 {
+            scanline.iter_mut().for_each(|s| *s += lines);
+        }
+        Ok(CoreBatch {
+            base,
+            x: cols.x,
+            y: cols.y,
+            z: cols.z,
+            t: cols.t,
+            rho_deg: k.rho_deg,
+            status: k.status,
+            scanline,
+            candidates: k
+                .candidates
+                .into_iter()
+                .map(|c| Candidate {
+                    scanline: c.scanline + lines,
+                    ..c
+                })
+                .collect(),
+        })
+    }
+}

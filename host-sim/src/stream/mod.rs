@@ -1,0 +1,306 @@
+//! `curbtrace extract` as one stream in bounded memory:
+//!
+//! ```text
+//! source (reader thread) ──► core (thread; chunks in parallel) ──► window + tracker ──► merge ──► edges
+//! LAS/LAZ files in time      projection, wire, Pipeline;           sections along the    pieces joined
+//! order, batches of points   whole lines only, the partial         route, closed as the  across section
+//! with their channel key     last line carried on                  vehicle passes them   boundaries
+//! ```
+//!
+//! The stages are joined by bounded channels (one batch in flight each way), so decoding
+//! runs beside the core and the tracker, and memory holds a few batches and one window:
+//! it does not grow with the input. Inputs not in time order are detected by the source
+//! and the run starts again on a chunk-wise external sort (see `source::external_sort`).
+//!
+//! - [`core_stage`] — the core stage (batches cut at line starts).
+//! - [`window`] — sections along the route, the bend method per window.
+//! - [`merge`] — joining pieces at section boundaries.
+
+pub mod core_stage;
+pub mod merge;
+pub mod window;
+
+use crate::config::{Config, ConfigError};
+use crate::io::las_in::ReadOptions;
+use crate::io::trajectory::Trajectory;
+use crate::model::EdgeLine;
+use crate::pipeline::{
+    ExtractError, ExtractOptions, ExtractResult, Method, Progress, StageTimes, Summary,
+};
+use crate::proc_stats::{peak_rss_bytes, process_cpu_s};
+use crate::replay::run::ReplayCounters;
+use crate::source::campaign::{Campaign, Source, SourceError};
+use crate::source::external_sort::{SortedRuns, RUN_POINTS};
+use crate::source::{PointBatch, BATCH_POINTS};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc::sync_channel;
+use std::time::Instant;
+pub use window::WindowParams;
+
+/// Points per batch the reader hands to the core stage.
+pub const STREAM_BATCH_POINTS: usize = BATCH_POINTS;
+
+/// What one pass over a source produced.
+struct Pass {
+    edges: Vec<EdgeLine>,
+    counters: ReplayCounters,
+    dropped: (u64, u64),
+    points: u64,
+    candidates: u64,
+    peak_window_points: usize,
+    times: StageTimes,
+}
+
+/// Extracts road edges with the bend method from one or many LAS/LAZ files (files,
+/// directories or glob patterns) and their trajectory, streaming in bounded memory.
+pub fn extract(
+    inputs: &[PathBuf],
+    traj_path: &Path,
+    cfg: &Config,
+    opts: &ExtractOptions,
+    window: &WindowParams,
+    progress: &Progress,
+) -> Result<ExtractResult, ExtractError> {
+    if opts.method != Method::Bend {
+        return Err(ExtractError::Method(opts.method.as_str().into()));
+    }
+    let start = Instant::now();
+    let cpu0 = process_cpu_s();
+    let traj = Trajectory::read_csv(traj_path)?;
+    let words = cfg.kernel_words().map_err(|what| ConfigError::Kernel {
+        path: PathBuf::from("(config)"),
+        what,
+    })?;
+    let read = ReadOptions {
+        scanner: opts.scanner,
+    };
+    let campaign = Campaign::open(inputs, &read).map_err(ExtractError::Source)?;
+    let info = campaign.info().clone();
+    drop(campaign);
+    let first = info.files.first().cloned().unwrap_or_default();
+    let mut sorted: Option<SortedRuns> = None;
+    let mut reordered = false;
+    let pass = loop {
+        // The `las` reader is not `Send`: the reader thread opens the files itself.
+        let spec = match sorted.take() {
+            Some(runs) => SourceSpec::Sorted(runs, info.clone()),
+            None => SourceSpec::Files(inputs.to_vec(), read),
+        };
+        match run_pass(spec, &traj, &words, cfg, window, progress, info.bytes) {
+            Ok((pass, sel)) => break (pass, sel),
+            Err(PassError::Source(SourceError::OutOfOrder { .. })) if !reordered => {
+                // Start again on the sorted runs.
+                reordered = true;
+                progress.stage("sorting", 0);
+                let c = Campaign::open(inputs, &read).map_err(ExtractError::Source)?;
+                sorted = Some(SortedRuns::build(c, RUN_POINTS).map_err(ExtractError::Source)?);
+            }
+            Err(PassError::Source(e)) => return Err(ExtractError::Source(e)),
+            Err(PassError::Core(e)) => {
+                return Err(ExtractError::Stream {
+                    path: first,
+                    what: e.to_string(),
+                })
+            }
+        }
+    };
+    let (mut pass, selection) = pass;
+    if pass.points == 0 {
+        return Err(ExtractError::NoCoverage {
+            points: first,
+            trajectory: traj_path.to_path_buf(),
+        });
+    }
+    for e in &mut pass.edges {
+        e.method
+            .get_or_insert_with(|| Method::Bend.as_str().to_string());
+    }
+    progress.finish();
+    let mut times = pass.times;
+    times.total_s = start.elapsed().as_secs_f64();
+    times.cpu.total_s = process_cpu_s() - cpu0;
+    times.cpu.peak_rss = [peak_rss_bytes(); 3];
+    let selected = pass.points + pass.dropped.0 + pass.dropped.1;
+    let summary = Summary {
+        las: info.las_info(selected, selection, reordered),
+        dropped_before_trajectory: pass.dropped.0,
+        dropped_after_trajectory: pass.dropped.1,
+        core: pass.counters,
+        candidates: pass.candidates,
+        edges: pass.edges.len() as u64,
+        total_length_m: pass.edges.iter().map(|e| e.length_m()).sum(),
+        times,
+    };
+    let _ = pass.peak_window_points;
+    Ok(ExtractResult {
+        crs: info.crs.clone(),
+        edges: pass.edges,
+        summary,
+    })
+}
+
+/// What the reader thread opens.
+enum SourceSpec {
+    Files(Vec<PathBuf>, ReadOptions),
+    Sorted(SortedRuns, crate::source::campaign::InputInfo),
+}
+
+impl SourceSpec {
+    fn open(self) -> Result<Source, SourceError> {
+        Ok(match self {
+            SourceSpec::Files(inputs, read) => Source::Files(Box::new(Campaign::open(&inputs, &read)?)),
+            SourceSpec::Sorted(runs, info) => Source::Sorted(runs, info),
+        })
+    }
+}
+
+enum PassError {
+    Source(SourceError),
+    Core(core_stage::CoreError),
+}
+
+/// One pass: reader thread → core thread → window on this thread.
+fn run_pass(
+    spec: SourceSpec,
+    traj: &Trajectory,
+    words: &[u32; curbtrace_core::kernel::CONFIG_WORDS],
+    cfg: &Config,
+    window: &WindowParams,
+    progress: &Progress,
+    bytes_total: u64,
+) -> Result<(Pass, crate::io::las_in::ScannerSelection), PassError> {
+    progress.stage_bytes("extract", bytes_total);
+    let bytes_done = AtomicU64::new(0);
+    let read_s = AtomicU64::new(0);
+    let core_s = AtomicU64::new(0);
+    std::thread::scope(|s| {
+        let (tx_b, rx_b) = sync_channel::<Result<PointBatch, SourceError>>(1);
+        let (tx_c, rx_c) = sync_channel::<Result<core_stage::CoreBatch, PassError>>(1);
+        let bytes_done = &bytes_done;
+        let (read_s, core_s) = (&read_s, &core_s);
+        let reader = s.spawn(move || {
+            let mut busy = 0.0;
+            let mut source = match spec.open() {
+                Ok(s) => s,
+                Err(e) => {
+                    let _ = tx_b.send(Err(e));
+                    return crate::io::las_in::ScannerSelection::All;
+                }
+            };
+            loop {
+                let t0 = Instant::now();
+                let b = source.next_batch(STREAM_BATCH_POINTS);
+                busy += t0.elapsed().as_secs_f64();
+                bytes_done.store(source.bytes_done(), Ordering::Relaxed);
+                let stop = !matches!(b, Ok(Some(_)));
+                let msg = match b {
+                    Ok(Some(b)) => Ok(b),
+                    Ok(None) => break,
+                    Err(e) => Err(e),
+                };
+                if tx_b.send(msg).is_err() || stop {
+                    break;
+                }
+            }
+            read_s.store(busy.to_bits(), Ordering::Relaxed);
+            source.selection()
+        });
+        let core = s.spawn(move || {
+            let mut stage = core_stage::CoreStage::new(traj, *words, cfg.replay);
+            let mut busy = 0.0;
+            for b in rx_b {
+                let b = match b {
+                    Ok(b) => b,
+                    Err(e) => {
+                        let _ = tx_c.send(Err(PassError::Source(e)));
+                        return None;
+                    }
+                };
+                let t0 = Instant::now();
+                let out = stage.push(b);
+                busy += t0.elapsed().as_secs_f64();
+                match out {
+                    Ok(Some(c)) => {
+                        if tx_c.send(Ok(c)).is_err() {
+                            return None;
+                        }
+                    }
+                    Ok(None) => {}
+                    Err(e) => {
+                        let _ = tx_c.send(Err(PassError::Core(e)));
+                        return None;
+                    }
+                }
+            }
+            let t0 = Instant::now();
+            match stage.finish() {
+                Ok(Some(c)) => {
+                    let _ = tx_c.send(Ok(c));
+                }
+                Ok(None) => {}
+                Err(e) => {
+                    let _ = tx_c.send(Err(PassError::Core(e)));
+                    return None;
+                }
+            }
+            busy += t0.elapsed().as_secs_f64();
+            core_s.store(busy.to_bits(), Ordering::Relaxed);
+            Some((stage.counters, stage.dropped, stage.points))
+        });
+        let mut win = window::SectionWindow::new(traj, *window, cfg.bend.clone());
+        let mut edges = Vec::new();
+        let mut candidates = 0u64;
+        let mut err = None;
+        let mut edges_s = 0.0;
+        for c in rx_c {
+            progress.set(bytes_done.load(Ordering::Relaxed));
+            match c {
+                Ok(c) => {
+                    candidates += c.candidates.len() as u64;
+                    let t0 = Instant::now();
+                    edges.extend(win.push(c));
+                    edges_s += t0.elapsed().as_secs_f64();
+                }
+                Err(e) => {
+                    err = Some(e);
+                    break;
+                }
+            }
+        }
+        let selection = reader
+            .join()
+            .unwrap_or_else(|p| std::panic::resume_unwind(p));
+        let core_out = core.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
+        if let Some(e) = err {
+            return Err(e);
+        }
+        let Some((counters, dropped, points)) = core_out else {
+            return Err(PassError::Core(core_stage::CoreError::Replay(
+                crate::replay::run::ReplayError::Stalled,
+            )));
+        };
+        let t0 = Instant::now();
+        edges.extend(win.finish());
+        edges_s += t0.elapsed().as_secs_f64();
+        progress.set(bytes_total);
+        let times = StageTimes {
+            read_s: f64::from_bits(read_s.load(Ordering::Relaxed)),
+            core_s: f64::from_bits(core_s.load(Ordering::Relaxed)),
+            edges_s,
+            ..StageTimes::default()
+        };
+        Ok((
+            Pass {
+                edges,
+                counters,
+                dropped,
+                points,
+                candidates,
+                peak_window_points: win.peak_points,
+                times,
+            },
+            selection,
+        ))
+    })
+}

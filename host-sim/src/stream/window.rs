@@ -1,0 +1,298 @@
+//! Window and tracker of the stream: sections along the route.
+//!
+//! The trajectory is small (a pose per few milliseconds of driving) and stays whole, so a
+//! point's *station* — the route's arc length at the point's time — is absolute, and the
+//! seed intervals of §2.6 (keyed to the station) line up with those of a whole-file run.
+//! The route is cut into sections of `section_m`; section k is `[s_k, s_k+1)`. Its window
+//! holds the points whose station lies in `[s_k − margin_m, s_k+1 + margin_m)`; seeding,
+//! tracking and the post-filters run on the window as on a whole file, and the parts of the
+//! edges whose vertices lie in the section (by the station of the nearest route point) are
+//! kept. Points arrive in time order, so stations never decrease: section k runs once a
+//! point passes `s_k+1 + margin_m`, and afterwards the points before `s_k+1 − margin_m` are
+//! evicted. Memory is the window: `section_m + 2 margin_m` metres of road.
+//!
+//! Pieces cut at a section boundary are joined by the [`Merge`](super::merge::Merge).
+//! A section as long as the route gives one window holding every point, and the edges of
+//! the whole-file run unchanged.
+
+use super::core_stage::CoreBatch;
+use super::merge::{Merge, Piece};
+use crate::bend::route::Route;
+use crate::bend::{self, BendInput, BendParams};
+use crate::io::trajectory::Trajectory;
+use crate::model::EdgeLine;
+use crate::replay::{Candidate, PointStatus};
+use serde::{Deserialize, Serialize};
+
+/// Parameters of the window (`[stream]` in the config file).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct WindowParams {
+    /// Length of a section of road whose edges are closed together, metres. Memory grows
+    /// with `section_m + 2 margin_m`, tracking work with `(section_m + 2 margin_m) /
+    /// section_m`.
+    pub section_m: f64,
+    /// Road before and after a section that its window also holds, metres. The window
+    /// selects points by the station of the vehicle when they were measured, the cut keeps
+    /// edge vertices by the station nearest to them; the two differ by up to the lateral
+    /// range times the tangent of the scanner's yaw and on curves. The margin covers that
+    /// difference plus the reach of a track from its seed and of the post-filters, so that
+    /// an edge inside the section sees what it would see in a whole-file run; the named
+    /// scenes need 20 m for identical geometry (docs/benchmarks.md).
+    pub margin_m: f64,
+}
+
+impl Default for WindowParams {
+    fn default() -> Self {
+        Self {
+            section_m: 10.0,
+            margin_m: 20.0,
+        }
+    }
+}
+
+/// The points of the window and their core output, indexed from `base` in the stream.
+#[derive(Default)]
+struct Columns {
+    base: u64,
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+    t: Vec<f64>,
+    rho: Vec<f32>,
+    status: Vec<Option<PointStatus>>,
+    scanline: Vec<u32>,
+    /// Candidates with stream indices.
+    candidates: Vec<(u64, Candidate)>,
+}
+
+impl Columns {
+    fn len(&self) -> usize {
+        self.t.len()
+    }
+
+    fn append(&mut self, b: CoreBatch) {
+        if self.t.is_empty() {
+            self.base = b.base;
+        }
+        // Grow by an eighth at a time, not by doubling: the window's columns are most of
+        // the stream's memory, and evicting from the front keeps their capacity.
+        let need = self.t.len() + b.t.len();
+        if need > self.t.capacity() {
+            let cap = need + need / 8;
+            grow(&mut self.x, cap);
+            grow(&mut self.y, cap);
+            grow(&mut self.z, cap);
+            grow(&mut self.t, cap);
+            grow(&mut self.rho, cap);
+            grow(&mut self.status, cap);
+            grow(&mut self.scanline, cap);
+        }
+        let base = b.base;
+        self.candidates.extend(
+            b.candidates
+                .into_iter()
+                .map(|c| (base + u64::from(c.point), c)),
+        );
+        self.x.extend(b.x);
+        self.y.extend(b.y);
+        self.z.extend(b.z);
+        self.t.extend(b.t);
+        self.rho.extend(b.rho_deg);
+        self.status.extend(b.status);
+        self.scanline.extend(b.scanline);
+    }
+
+    fn evict(&mut self, n: usize) {
+        self.x.drain(..n);
+        self.y.drain(..n);
+        self.z.drain(..n);
+        self.t.drain(..n);
+        self.rho.drain(..n);
+        self.status.drain(..n);
+        self.scanline.drain(..n);
+        self.base += n as u64;
+        let base = self.base;
+        self.candidates.retain(|c| c.0 >= base);
+    }
+}
+
+fn grow<T>(v: &mut Vec<T>, cap: usize) {
+    v.reserve_exact(cap.saturating_sub(v.len()));
+}
+
+/// The section window and the bend method's tracker over it.
+pub struct SectionWindow<'a> {
+    traj: &'a Trajectory,
+    route: Route,
+    params: WindowParams,
+    bend: BendParams,
+    cols: Columns,
+    /// Index of the next section to run.
+    next: i64,
+    merge: Merge,
+    /// Most points the window held at once.
+    pub peak_points: usize,
+}
+
+impl<'a> SectionWindow<'a> {
+    /// A window over `traj`'s route.
+    pub fn new(traj: &'a Trajectory, params: WindowParams, bend: BendParams) -> Self {
+        // Two pieces of one curb meet within a few search steps of each other.
+        let stitch = (3.0 * bend.search_distance_m).max(bend.join_distance_m);
+        let min_len = bend.min_edge_length_m;
+        Self {
+            traj,
+            route: Route::new(traj),
+            bend,
+            params,
+            cols: Columns::default(),
+            next: 0,
+            merge: Merge::new(stitch, min_len),
+            peak_points: 0,
+        }
+    }
+
+    fn section_m(&self) -> f64 {
+        self.params.section_m.max(1.0)
+    }
+
+    fn station(&self, t: f64) -> f64 {
+        self.route.arc_at(t).unwrap_or(0.0)
+    }
+
+    /// True when the whole route is one section: the window is the whole input.
+    fn single(&self) -> bool {
+        self.section_m() > self.route.length_m()
+    }
+
+    /// Takes the core's output for the next points and runs every section they complete.
+    pub fn push(&mut self, b: CoreBatch) -> Vec<EdgeLine> {
+        self.cols.append(b);
+        self.peak_points = self.peak_points.max(self.cols.len());
+        let mut out = Vec::new();
+        if self.single() {
+            return out;
+        }
+        let Some(&t_last) = self.cols.t.last() else {
+            return out;
+        };
+        let s_last = self.station(t_last);
+        let l = self.section_m();
+        while (self.next + 1) as f64 * l + self.params.margin_m.max(0.0) <= s_last {
+            out.extend(self.run_section());
+        }
+        out
+    }
+
+    /// Runs the remaining sections and closes every edge.
+    pub fn finish(&mut self) -> Vec<EdgeLine> {
+        if self.single() {
+            return self
+                .extract_range(0, self.cols.len())
+                .into_iter()
+                .map(|(e, _)| e)
+                .collect();
+        }
+        let mut out = Vec::new();
+        let l = self.section_m();
+        let end = self.route.length_m();
+        while (self.next as f64) * l <= end && !self.cols.t.is_empty() {
+            out.extend(self.run_section());
+        }
+        out.extend(self.merge.close_all());
+        out
+    }
+
+    /// Runs section `next`, then evicts the points the next section does not need.
+    fn run_section(&mut self) -> Vec<EdgeLine> {
+        let l = self.section_m();
+        let m = self.params.margin_m.max(0.0);
+        let k = self.next;
+        let (s0, s1) = (k as f64 * l, (k + 1) as f64 * l);
+        let lo = self.cols.t.partition_point(|&t| self.station(t) < s0 - m);
+        let hi = self.cols.t.partition_point(|&t| self.station(t) < s1 + m);
+        let edges = if hi > lo {
+            self.extract_range(lo, hi)
+        } else {
+            Vec::new()
+        };
+        let mut pieces = Vec::new();
+        for (e, steps) in edges {
+            pieces.extend(cut_to_section(&self.route, e, steps, s0, s1));
+        }
+        let closed = self.merge.push(pieces, s0, s1);
+        self.next += 1;
+        let keep_from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
+        self.cols.evict(keep_from);
+        closed
+    }
+
+    /// The bend method on the window's points `lo..hi`.
+    fn extract_range(&self, lo: usize, hi: usize) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
+        let c = &self.cols;
+        let (glo, ghi) = (c.base + lo as u64, c.base + hi as u64);
+        let cands: Vec<Candidate> = c
+            .candidates
+            .iter()
+            .filter(|(g, _)| (glo..ghi).contains(g))
+            .map(|(g, cand)| Candidate {
+                point: (g - glo) as u32,
+                ..*cand
+            })
+            .collect();
+        let input = BendInput {
+            x: &c.x[lo..hi],
+            y: &c.y[lo..hi],
+            z: &c.z[lo..hi],
+            t: &c.t[lo..hi],
+            rho_deg: &c.rho[lo..hi],
+            status: &c.status[lo..hi],
+            scanline: &c.scanline[lo..hi],
+            candidates: &cands,
+            trajectory: self.traj,
+        };
+        bend::extract_edges_with_steps(&input, &self.bend)
+    }
+}
+
+/// The runs of an edge's vertices whose station lies in `[s0, s1)`, each as a piece.
+fn cut_to_section(
+    route: &Route,
+    e: EdgeLine,
+    steps: Vec<Option<f64>>,
+    s0: f64,
+    s1: f64,
+) -> Vec<Piece> {
+    let st: Vec<f64> = e
+        .points
+        .iter()
+        .map(|p| route.station_near(p[0], p[1]).unwrap_or(f64::NAN))
+        .collect();
+    let inside = |s: f64| s >= s0 && s < s1;
+    if st.iter().all(|&s| inside(s)) {
+        return vec![Piece::whole(e, steps)];
+    }
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k < st.len() {
+        if !inside(st[k]) {
+            k += 1;
+            continue;
+        }
+        let a = k;
+        while k < st.len() && inside(st[k]) {
+            k += 1;
+        }
+        out.push(Piece::cut(
+            EdgeLine {
+                points: e.points[a..k].to_vec(),
+                ..e.clone()
+            },
+            steps[a..k].to_vec(),
+            a > 0,
+            k < st.len(),
+        ));
+    }
+    out
+}
