@@ -59,6 +59,10 @@ def street(out, seed):
     r["spacing_m"] = float(m.group(1)) if m else None
     m = re.search(r"far side (left|right)", desc)
     r["far"] = m.group(1) if m else None
+    m = re.search(r"yaw (-?\d+)° pitch (\d+)°", desc)
+    r["yaw"], r["pitch"] = (int(m.group(1)), int(m.group(2))) if m else (None, None)
+    m = re.search(r"(\d+) parked", desc)
+    r["parked"] = int(m.group(1)) if m else None
     m = re.search(r": (\d+) points", sim[1] if len(sim) > 1 else "")
     r["points"] = int(m.group(1)) if m else None
     for method in ["bend", "qiu"]:
@@ -77,6 +81,7 @@ def street(out, seed):
             e[c] = combine(cols) if cols and sum(x["reference_m"] for x in cols) > 0 else None
         for s in j["sides"]:
             e["side_" + s["side"]] = combine([s["total"]])
+        e["unattributed_m"] = j["extracted_unattributed_m"]
         r[method] = e
         w = re.search(r"wall_ms (\d+)", (d / f"{method}.extract.txt").read_text())
         r[method + "_ms"] = int(w.group(1)) if w else None
@@ -129,6 +134,29 @@ def main():
     p("take both sides together and count only the streets that have the category in their")
     p("reference.")
     p()
+    med = lambda xs: percentile([x for x in xs if x is not None], 0.5)
+    cat_q = lambda m, c: [s[m][c]["quality"] if s[m][c] else None for s in (bend if m == "bend" else qiu)]
+    close_q = [s["bend"]["total"]["quality"] for s in bend if s["spacing_m"] is not None and s["spacing_m"] <= 0.15]
+    targets = [
+        ("bend median total quality", med([s["bend"]["total"]["quality"] for s in bend]), ">= 96"),
+        ("bend 10th percentile total quality", percentile([s["bend"]["total"]["quality"] for s in bend], 0.1), ">= 93"),
+        ("bend lowest total quality, lines ≤ 0.15 m apart", min(close_q) if close_q else None, ">= 90"),
+        ("bend median curb-cut quality", med(cat_q("bend", "curb_cut")), ">= 90"),
+        ("bend median intersection quality", med(cat_q("bend", "intersection")), ">= 85"),
+        ("bend largest RMS [mm]", max(s["bend"]["rms_mm"] or 0.0 for s in bend) if bend else None, "<= 15"),
+        ("qiu median completeness", med([s["qiu"]["total"]["completeness"] for s in qiu]), ">= 92"),
+        ("qiu median correctness", med([s["qiu"]["total"]["correctness"] for s in qiu]), ">= 97"),
+        ("qiu median far-side completeness", med([s["qiu"].get("side_" + (s["far"] or ""), {}).get("completeness") for s in qiu]), ">= 88"),
+    ]
+    p("## Targets")
+    p()
+    p("| what | measured | target | met |")
+    p("|---|---:|---:|:---:|")
+    for name, v, t in targets:
+        op, bound = t.split()
+        ok = v is not None and (v >= float(bound) if op == ">=" else v <= float(bound))
+        p(f"| {name} | {fmt(v)} | {t.replace('>=', '≥').replace('<=', '≤')} | {'yes' if ok else 'no'} |")
+    p()
     p("## bend, 50 mm buffer")
     p()
     p("| quality [%] | streets | min | 10th pct | median | mean |")
@@ -155,6 +183,28 @@ def main():
     below90 = sorted((s["bend"]["total"]["quality"] or 0.0, s["seed"]) for s in close if (s["bend"]["total"]["quality"] or 0.0) < 90.0)
     p()
     p("Below 90 % among them: " + (", ".join(f"seed {sd} ({q:.1f} %)" for q, sd in below90) or "none") + ".")
+    p()
+    p("### By condition")
+    p()
+    near = lambda s: s["bend"].get("side_" + ("right" if s["far"] == "left" else "left"), {}).get("quality")
+    far = lambda s: s["bend"].get("side_" + (s["far"] or ""), {}).get("quality")
+    gap = [s for s in bend if s["pitch"] is not None and s["pitch"] < 10 and abs(s["yaw"]) >= 45]
+    rest = [s for s in bend if s not in gap]
+    many = [s for s in bend if (s["parked"] or 0) >= 8]
+    none = [s for s in bend if s["parked"] == 0]
+    p("| bend quality [%] | streets | min | 10th pct | median | mean |")
+    p("|---|---:|---:|---:|---:|---:|")
+    p(dist_row("near side (the vehicle's lane side)", [near(s) for s in bend], n_all))
+    p(dist_row("far side", [far(s) for s in bend], n_all))
+    p(dist_row("total, mount pitch < 10° and \\|yaw\\| ≥ 45°", [s["bend"]["total"]["quality"] for s in gap], n_all))
+    p(dist_row("total, the other mounts", [s["bend"]["total"]["quality"] for s in rest], n_all))
+    p(dist_row("curb completeness, ≥ 8 parked vehicles", [s["bend"]["curb"]["completeness"] if s["bend"]["curb"] else None for s in many], n_all))
+    p(dist_row("curb completeness, no parked vehicle", [s["bend"]["curb"]["completeness"] if s["bend"]["curb"] else None for s in none], n_all))
+    p()
+    p("Extracted length farther than 2 m from every reference line (phantom edges), bend: "
+      f"{sum(s['bend']['unattributed_m'] for s in gap):.0f} m on the {len(gap)} streets with pitch < 10° and |yaw| ≥ 45° "
+      f"({', '.join(str(s['seed']) for s in gap) or 'none'}), "
+      f"{sum(s['bend']['unattributed_m'] for s in rest):.0f} m on the other {len(rest)}.")
     p()
     p("## qiu, 200 mm buffer")
     p()

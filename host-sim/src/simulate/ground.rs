@@ -670,4 +670,69 @@ mod tests {
             .intersect([5.0, -2.0, 2.0], [0.0, 0.6, 0.8], 0.0, 50.0)
             .is_none());
     }
+
+    #[test]
+    fn a_cut_without_lip_starts_at_the_road_and_breaks_slope_at_the_toe() {
+        let sh = CurbShape::default();
+        // Continuous at the toe, then rising along the ramp to the sidewalk height.
+        assert!(step_profile(&sh, 1e-6, 0.0, 0.15) < 1e-5);
+        let (a, b) = (
+            step_profile(&sh, 0.1, 0.0, 0.15),
+            step_profile(&sh, 0.2, 0.0, 0.15),
+        );
+        assert!(a > 0.015 && b > a, "{a} {b}");
+        assert!(
+            (step_profile(&sh, sh.ramp_m, 0.0, 0.15) - 0.15 - sh.walk_slope * sh.ramp_m).abs()
+                < 1e-9
+        );
+    }
+
+    #[test]
+    fn a_chamfer_cuts_the_top_edge_straight() {
+        let sh = CurbShape {
+            chamfer: true,
+            top_radius_m: 0.02,
+            ..CurbShape::default()
+        };
+        let (hc, b) = (0.15, 0.1 * 0.15);
+        // Face up to 20 mm below the top, then a straight line to the top 20 mm behind.
+        let fs = b * (hc - 0.02) / hc;
+        assert!((step_profile(&sh, fs, hc, hc) - (hc - 0.02)).abs() < 1e-9);
+        let mid = 0.5 * (fs + b + 0.02);
+        assert!((step_profile(&sh, mid, hc, hc) - (hc - 0.01)).abs() < 1e-9);
+        assert!((step_profile(&sh, b + 0.02, hc, hc) - hc).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_gutter_falls_more_steeply_to_the_toe() {
+        let pts: Vec<[f64; 2]> = (0..=40).map(|i| [i as f64 * 0.5, 0.0]).collect();
+        let n = pts.len();
+        let toe = ToeLine {
+            pts,
+            h_curb: vec![0.15; n],
+            h_walk: vec![0.15; n],
+            category: vec![Category::Curb; n],
+            crown_m: 3.0,
+        };
+        let shape = CurbShape {
+            gutter_m: 0.4,
+            gutter_slope: 0.06,
+            ..CurbShape::default()
+        };
+        let flat = Base {
+            grade_x: 0.0,
+            grade_y: 0.0,
+            wave_m: 0.0,
+        };
+        let g = Ground::build(vec![toe], shape, flat, [-5.0, -8.0, 25.0, 8.0], 0.15);
+        let at = |y: f64| g.height(10.0, y).unwrap().0;
+        // Road 2 % down to the gutter's edge (8 mm at 0.4 m), then 6 %: 16 mm lower at the toe.
+        assert!((at(-0.4) - 0.008).abs() < 1e-9, "{}", at(-0.4));
+        assert!(
+            (at(-1e-4) - (0.008 - 0.06 * 0.4)).abs() < 1e-5,
+            "{}",
+            at(-1e-4)
+        );
+        assert!(Ground::max_slope(&shape, &flat) >= 0.1);
+    }
 }

@@ -504,6 +504,8 @@ mod tests {
             width: 8.0,
             radius: 6.0,
             length: 20.0,
+            angle_deg: 90.0,
+            flare: 1.0,
         });
         let pieces = s.toe_pieces(Side::Right);
         assert_eq!(pieces.len(), 2);
@@ -520,5 +522,49 @@ mod tests {
         // The last vertex of the first piece is at the side street's end.
         let last = pieces[0].last().unwrap();
         assert!((last.0[0] - 16.0).abs() < 1e-9 && (last.0[1] - 24.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn an_oblique_flared_side_street_leaves_at_its_angle_without_jumps() {
+        let mut s = crate::simulate::scene_by_name("tiny").unwrap();
+        let x = Intersection {
+            side: Side::Left,
+            u: 20.0,
+            width: 8.0,
+            radius: 6.0,
+            length: 20.0,
+            angle_deg: 60.0,
+            flare: 2.0,
+        };
+        s.intersections.push(x);
+        let pieces = s.toe_pieces(Side::Left);
+        assert_eq!(pieces.len(), 2);
+        for piece in &pieces {
+            for w in piece.windows(2) {
+                let d = (w[1].0[0] - w[0].0[0]).hypot(w[1].0[1] - w[0].0[1]);
+                assert!(d < 0.3, "step of {d} m at {:?}", w[0].0);
+            }
+        }
+        // The side street's curbs run at 60° and end 20 m out.
+        for (piece, end) in [(&pieces[0], pieces[0].len() - 1), (&pieces[1], 0)] {
+            let (p, q) = (piece[end].0, piece[if end == 0 { 1 } else { end - 1 }].0);
+            let ang = (p[1] - q[1]).atan2(p[0] - q[0]).to_degrees();
+            assert!((ang - 60.0).abs() < 1e-6, "{ang}");
+            assert!((p[1] - 4.0 - 20.0).abs() < 1e-9);
+        }
+        // Both curb lines are 8 m apart across the street.
+        let (a, b) = (pieces[0].last().unwrap().0, pieces[1][0].0);
+        let (sn, cs) = 60f64.to_radians().sin_cos();
+        assert!(((b[0] - a[0]) * sn - (b[1] - a[1]) * cs - 8.0).abs() < 1e-6);
+        let (m0, m1) = s.mouth(&x);
+        assert!(
+            m0 < pieces[0]
+                .iter()
+                .rev()
+                .find(|v| v.3 == Category::Curb)
+                .unwrap()
+                .0[0]
+        );
+        assert!(m1 > pieces[1].iter().find(|v| v.3 == Category::Curb).unwrap().0[0]);
     }
 }
