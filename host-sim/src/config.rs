@@ -141,7 +141,7 @@ mod tests {
         let e = Config::read(&p).unwrap_err().to_string();
         assert!(
             e.ends_with(
-                "k.toml: [kernel]: tau_max_deg = 30 is outside its range (tau_min_deg, 180]"
+                "k.toml: [kernel]: tau_max_deg is NaN, infinite or outside its range (tau_min_deg, 180]"
             ),
             "{e}"
         );
