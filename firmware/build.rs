@@ -18,7 +18,8 @@ fn main() {
     println!("cargo:rerun-if-changed={}", memory_x.display());
     println!("cargo:rerun-if-changed={}", stack_x.display());
     println!("cargo:rerun-if-changed=build.rs");
-    if env::var_os("CARGO_FEATURE_DEFMT").is_some() || env::var_os("CARGO_FEATURE_BOARD").is_some() {
+    if env::var_os("CARGO_FEATURE_DEFMT").is_some() || env::var_os("CARGO_FEATURE_BOARD").is_some()
+    {
         println!("cargo:rustc-link-arg=-Tdefmt.x");
     }
 }

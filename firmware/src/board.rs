@@ -89,8 +89,7 @@ fn main() -> ! {
         let _rx = gpiob.pb11.into_alternate::<7>();
         pac::USART3::enable(&mut rcc);
         let brr = usart::brr(clocks.pclk1().raw(), INPUT_BAUD);
-        let Some(rx) = usart::RxLink::usart3(brr, usart::EndOfStream::Never, feed_watchdog)
-        else {
+        let Some(rx) = usart::RxLink::usart3(brr, usart::EndOfStream::Never, feed_watchdog) else {
             panic_record::record_and_reset(format_args!("USART3 set up twice"))
         };
         rx
@@ -143,7 +142,7 @@ fn feed_watchdog() {
 /// The LED follows the parity of the line count: it toggles once per scanline.
 fn blink(led: &mut impl OutputPin, lines: u64) {
     // A GPIO write on this part cannot fail (the error type is Infallible).
-    let _ = if lines % 2 == 0 {
+    let _ = if lines.is_multiple_of(2) {
         led.set_low()
     } else {
         led.set_high()

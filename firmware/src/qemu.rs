@@ -16,6 +16,7 @@ use crate::semihosting_io::{self, HostFile, Mode};
 use crate::stack;
 use curbtrace_firmware::args::{self, Command};
 
+use core::ffi::CStr;
 use core::ptr::addr_of_mut;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
@@ -76,6 +77,13 @@ fn main() -> ! {
             exit_failure()
         }
     };
+    over_files(input_name, output_name)
+}
+
+/// Processes the host file `input_name` into `output_name` and exits. Not inlined, so that
+/// its frame and the `--usart` path's are not both on the stack.
+#[inline(never)]
+fn over_files(input_name: &CStr, output_name: &CStr) -> ! {
     let mut input = match HostFile::open(input_name, Mode::ReadBinary) {
         Ok(f) => f,
         Err(e) => {
@@ -154,6 +162,7 @@ fn figures(summary: &Summary, stack_init: usize) {
 /// 2), the packets out on USART6 (index 5); the figures add the receive counters. Fails if
 /// the stream stalls (no byte for [`USART_IDLE_MS`]) before all its bytes arrived.
 #[cfg(feature = "usart")]
+#[inline(never)]
 fn over_usarts(bytes: u64) -> ! {
     use crate::{ticks, usart};
     use usart::{EndOfStream, RxLink, TxLink};

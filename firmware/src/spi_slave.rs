@@ -92,7 +92,8 @@ impl SpiSlaveRx {
         while st.cr().read().bits() & CR_EN != 0 {}
         dma.lifcr()
             .write(|w| unsafe { w.bits(TCIF3 | HTIF3 | TEIF3 | DMEIF3 | FEIF3) });
-        st.par().write(|w| unsafe { w.bits(spi.dr().as_ptr() as u32) });
+        st.par()
+            .write(|w| unsafe { w.bits(spi.dr().as_ptr() as u32) });
         st.m0ar()
             .write(|w| unsafe { w.bits(addr_of!(BUFFER) as u32) });
         st.ndtr().write(|w| unsafe { w.bits(DMA_BYTES as u32) });

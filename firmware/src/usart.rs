@@ -96,6 +96,7 @@ pub const fn brr(pclk_hz: u32, baud: u32) -> u16 {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EndOfStream {
     /// Never: a board's link is open for ever.
+    #[cfg_attr(not(feature = "board"), allow(dead_code))]
     Never,
     /// After this many bytes in all, or when no byte came for `idle_ms` milliseconds
     /// ([`RxLink::timed_out`] tells which).
