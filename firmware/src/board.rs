@@ -38,7 +38,8 @@ pub const HSE_HZ: u32 = 12_000_000;
 /// The core clock.
 pub const SYSCLK_HZ: u32 = 168_000_000;
 #[cfg(not(feature = "spi-input"))]
-/// Input link speed (USART3): about 92 kB/s, some 4 500 points/s of today's 20.4-byte point records.
+/// Input link speed (USART3): about 92 kB/s, some 4 500 points/s of today's 20.4-byte point
+/// records.
 pub const INPUT_BAUD: u32 = 921_600;
 /// Output link speed (USART6, on APB2).
 pub const OUTPUT_BAUD: u32 = 921_600;
