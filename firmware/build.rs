@@ -1,13 +1,13 @@
 //! Puts the STM32F405's real memory map (the repository root's `memory.x`) and the stack
 //! placement (`stack.x`) on the linker's search path, and the defmt linker script when the
-//! `defmt` feature is on.
+//! `defmt` (QEMU) or `board` feature is on.
 
 use std::{env, fs, path::PathBuf};
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     let manifest = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets it"));
-    // The one memory map of the part lives at the repository root (SPEC §1); copy it verbatim.
+    // The one memory map of the part lives at the repository root (docs/spec.md §1); copy it verbatim.
     let memory_x = manifest.join("../memory.x");
     fs::copy(&memory_x, out.join("memory.x"))
         .unwrap_or_else(|e| panic!("copying {}: {e}", memory_x.display()));
@@ -18,7 +18,8 @@ fn main() {
     println!("cargo:rerun-if-changed={}", memory_x.display());
     println!("cargo:rerun-if-changed={}", stack_x.display());
     println!("cargo:rerun-if-changed=build.rs");
-    if env::var_os("CARGO_FEATURE_DEFMT").is_some() {
+    if env::var_os("CARGO_FEATURE_DEFMT").is_some() || env::var_os("CARGO_FEATURE_BOARD").is_some()
+    {
         println!("cargo:rustc-link-arg=-Tdefmt.x");
     }
 }

@@ -42,10 +42,12 @@ for feat in libm micromath; do
 done
 
 # --- firmware: the core on the STM32F405 under QEMU (firmware/check.sh) ----------------------
-step "firmware: cargo fmt --check, clippy on the host target (-D warnings), host-check tests"
+step "firmware: cargo fmt --check, clippy on the host target for the QEMU, USART and board builds (-D warnings), host-check tests"
 (cd firmware && cargo fmt --check)
-(cd firmware && cargo clippy --release --target x86_64-unknown-linux-gnu --all-targets \
-  --config 'profile.release.panic="abort"' -- -D warnings)
+for feat in libm usart board spi-input; do
+  (cd firmware && cargo clippy --release --target x86_64-unknown-linux-gnu --all-targets \
+    --features "$feat" --config 'profile.release.panic="abort"' -- -D warnings)
+done
 (cd firmware && cargo test --lib --target x86_64-unknown-linux-gnu)
 HC_TARGET="${CARGO_TARGET_DIR:-$ROOT/target}/firmware-host-check"
 cargo fmt --check --manifest-path firmware/host-check/Cargo.toml
@@ -58,7 +60,19 @@ cargo run --release --quiet -p curbtrace-host-sim -- simulate --scene tiny -o "$
 cargo run --release --quiet -p curbtrace-host-sim -- replay "$FW_WORK/sim/points.laz" \
   --trajectory "$FW_WORK/sim/trajectory.csv" -o "$FW_WORK/tiny.bin"
 QEMU_TIMEOUT=300 firmware/check.sh "$FW_WORK/tiny.bin"
+
+step "firmware: the USART links under QEMU: the tiny stream's first 1 MB in on USART3, the packets out on USART6, compared with the host core (firmware/usart-test.sh)"
+QEMU_TIMEOUT=240 timeout 300 firmware/usart-test.sh "$FW_WORK/tiny.bin" 1000000 < /dev/null
 rm -rf "$FW_WORK"
+
+step "firmware: the board build (Feather STM32F405; USART and SPI-slave inputs; built, cannot run here)"
+for feat in board spi-input; do
+  (cd firmware && RUSTC_BOOTSTRAP=1 RUSTC=/usr/bin/rustc \
+    CARGO_TARGET_DIR="${FIRMWARE_TARGET_DIR:-$ROOT/firmware/target}/board" \
+    /usr/bin/cargo build --release --locked --quiet --features "$feat")
+  size -A "${FIRMWARE_TARGET_DIR:-firmware/target}/board/thumbv7em-none-eabihf/release/curbtrace-firmware" |
+    awk -v f="$feat" '$1 ~ /^\.(vector_table|text|rodata|data|bss|uninit|stack)$/ { s = s " " $1 "=" $2 } END { print "board (" f "):" s }'
+done
 
 step "firmware: a stack overflow, a HardFault and a panic each end the QEMU run with a failure"
 for t in overflow hardfault panic; do

@@ -74,6 +74,19 @@ pub fn run<R: Read, W: Write, const RING: usize, const N: usize>(
     output: &mut W,
     packet: &mut [u8; MAX_PACKET_LEN],
 ) -> Result<Summary, Error<R::Error, W::Error>> {
+    run_observed(pipeline, input, output, packet, |_, _| {})
+}
+
+/// [`run`], calling `observe` with the pipeline and the running summary after every transfer
+/// into the ring has been processed (a board feeds its watchdog, blinks and logs there; it
+/// reads the pipeline's counters only when it needs them).
+pub fn run_observed<R: Read, W: Write, const RING: usize, const N: usize>(
+    pipeline: &mut Pipeline<RING, N>,
+    input: &mut R,
+    output: &mut W,
+    packet: &mut [u8; MAX_PACKET_LEN],
+    mut observe: impl FnMut(&Pipeline<RING, N>, &Summary),
+) -> Result<Summary, Error<R::Error, W::Error>> {
     let mut sink = Sink {
         enc: StreamEncoder::new(),
         packet,
@@ -97,6 +110,7 @@ pub fn run<R: Read, W: Write, const RING: usize, const N: usize>(
         if let Some(e) = sink.failed.take() {
             return Err(e);
         }
+        observe(pipeline, &sink.sum);
     }
     pipeline.finish(|out| sink.line(out));
     if let Some(e) = sink.failed.take() {
@@ -278,6 +292,33 @@ mod tests {
             );
             at += len;
         }
+    }
+
+    #[test]
+    fn the_observer_sees_every_transfer_and_the_lines_so_far() {
+        let input = stream(&KernelParams::DEFAULT.to_words(), 3, 300);
+        let mut node: Box<Pipeline<RING, 512>> = Box::default();
+        let mut packet = [0u8; MAX_PACKET_LEN];
+        let mut out = Sink(Vec::new());
+        let step = 500;
+        let (mut calls, mut last_lines, mut last_packets) = (0usize, 0, 0);
+        let sum = run_observed(
+            &mut node,
+            &mut Trickle { data: &input, step },
+            &mut out,
+            &mut packet,
+            |p, s| {
+                calls += 1;
+                let lines = p.counters().kernel_lines;
+                assert!(lines >= last_lines && s.packets_out >= last_packets);
+                (last_lines, last_packets) = (lines, s.packets_out);
+            },
+        )
+        .expect("runs");
+        assert_eq!(calls, input.len().div_ceil(step));
+        // The last line is handed over by `finish`, after the last transfer.
+        assert_eq!(last_lines, 2);
+        assert_eq!(sum.counters.kernel_lines, 3);
     }
 
     #[test]

@@ -2,8 +2,10 @@
 //! `-semihosting-config …,arg=fw,arg=IN,arg=OUT` as `"fw IN OUT"`).
 //!
 //! `fw [IN [OUT]]` processes IN (default `stream.bin`) into OUT (default `results.bin`);
-//! `fw --selftest=overflow|hardfault|panic` provokes that failure, to check that each one
-//! ends the run with a non-zero exit instead of a hang or a silent success.
+//! `fw --usart=BYTES` processes a stream of BYTES bytes arriving on USART3 into packets sent
+//! on USART6 (QEMU's `-serial` chardevs); `fw --selftest=overflow|hardfault|panic` provokes
+//! that failure, to check that each one ends the run with a non-zero exit instead of a hang
+//! or a silent success.
 
 use core::ffi::CStr;
 
@@ -16,6 +18,11 @@ pub enum Command<'a> {
         input: &'a CStr,
         /// The output file's host path.
         output: &'a CStr,
+    },
+    /// Process a stream of `bytes` bytes from USART3 into packets on USART6.
+    Usart {
+        /// The stream's length: the run ends once this many bytes have arrived.
+        bytes: u64,
     },
     /// Overflow the stack (it must fault: the stack lies below the statics).
     SelfTestOverflow,
@@ -30,8 +37,10 @@ pub enum Command<'a> {
 pub enum ArgsError {
     /// More than two file names.
     TooManyArguments,
-    /// An option other than the self-tests.
+    /// An option other than the self-tests and `--usart=BYTES`.
     UnknownOption,
+    /// `--usart=` without a whole number of bytes.
+    BadByteCount,
 }
 
 /// Parses the command line held in `buf[..len]` in place: the words' separators become NULs,
@@ -59,6 +68,13 @@ pub fn parse(buf: &mut [u8], len: usize) -> Result<Command<'_>, ArgsError> {
         return Err(ArgsError::TooManyArguments);
     }
     if let Some(opt) = first.filter(|w| w.to_bytes().starts_with(b"--")) {
+        if let Some(count) = opt.to_bytes().strip_prefix(b"--usart=") {
+            return core::str::from_utf8(count)
+                .ok()
+                .and_then(|c| c.parse().ok())
+                .map(|bytes| Command::Usart { bytes })
+                .ok_or(ArgsError::BadByteCount);
+        }
         return match opt.to_bytes() {
             b"--selftest=overflow" => Ok(Command::SelfTestOverflow),
             b"--selftest=hardfault" => Ok(Command::SelfTestHardFault),
@@ -119,6 +135,13 @@ mod tests {
         );
         assert_eq!(parse_str("fw --selftest=panic"), Ok(Command::SelfTestPanic));
         assert_eq!(parse_str("fw --bogus"), Err(ArgsError::UnknownOption));
+        assert_eq!(
+            parse_str("fw --usart=123456"),
+            Ok(Command::Usart { bytes: 123456 })
+        );
+        assert_eq!(parse_str("fw --usart="), Err(ArgsError::BadByteCount));
+        assert_eq!(parse_str("fw --usart=-1"), Err(ArgsError::BadByteCount));
+        assert_eq!(parse_str("fw --usart"), Err(ArgsError::UnknownOption));
         assert_eq!(parse_str("fw a b c"), Err(ArgsError::TooManyArguments));
     }
 
