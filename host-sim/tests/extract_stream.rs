@@ -52,7 +52,7 @@ fn write_parts(src: &Path, dir: &Path, cuts: &[usize], reverse: bool) -> Vec<Pat
     header.point_format.is_compressed = false;
     let header = header.into_header().unwrap();
     let mut points: Vec<las::Point> = Vec::new();
-    points.extend(reader.read_all().unwrap().points());
+    points.extend(reader.read_all().unwrap().points().map(|p| p.unwrap()));
     let mut bounds = vec![0];
     bounds.extend_from_slice(cuts);
     bounds.push(points.len());

@@ -149,7 +149,9 @@ enum SourceSpec {
 impl SourceSpec {
     fn open(self) -> Result<Source, SourceError> {
         Ok(match self {
-            SourceSpec::Files(inputs, read) => Source::Files(Box::new(Campaign::open(&inputs, &read)?)),
+            SourceSpec::Files(inputs, read) => {
+                Source::Files(Box::new(Campaign::open(&inputs, &read)?))
+            }
             SourceSpec::Sorted(runs, info) => Source::Sorted(runs, info),
         })
     }
