@@ -1,4 +1,4 @@
-//! Bad input (issue 4): each one gives a one-line error naming the file and the problem,
+//! Bad input: each one gives a one-line error naming the file and the problem,
 //! never a panic. Small LAS/LAZ files are built here with the `las` writer.
 
 use curbtrace_host_sim::io::las_in::{read_points, ReadOptions};
