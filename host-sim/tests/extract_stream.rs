@@ -126,7 +126,7 @@ fn several_files_in_any_order_and_out_of_order_files_give_the_same_edges() {
     assert_eq!(multi.summary.core, base.summary.core);
     assert!(!multi.summary.las.was_reordered);
     // The directory as input reads the same files.
-    let by_dir = streamed(&[parts_dir.clone()], &traj, &w);
+    let by_dir = streamed(std::slice::from_ref(&parts_dir), &traj, &w);
     assert_eq!(geojson(&by_dir), geojson(&base));
     // Each file stored backwards in time: detected, sorted through a temporary directory.
     let rev_dir = dir.path().join("rev");
@@ -150,8 +150,7 @@ fn bad_inputs_name_the_file() {
         &WindowParams::default(),
         &Progress::hidden(),
     )
-    .err()
-    .expect("no input is an error")
+    .expect_err("no input is an error")
     .to_string();
     assert!(err.contains("nothing-*.laz"), "{err}");
     let bad = dir.path().join("bad.laz");
@@ -164,8 +163,7 @@ fn bad_inputs_name_the_file() {
         &WindowParams::default(),
         &Progress::hidden(),
     )
-    .err()
-    .expect("a bad file is an error")
+    .expect_err("a bad file is an error")
     .to_string();
     assert!(err.contains("bad.laz"), "{err}");
 }
