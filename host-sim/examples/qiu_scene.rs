@@ -13,7 +13,8 @@
 
 use curbtrace_host_sim::eval::{evaluate, EvalParams};
 use curbtrace_host_sim::io::trajectory::Trajectory;
-use curbtrace_host_sim::model::{read_geojson, write_geojson, Crs};
+use curbtrace_host_sim::model::{read_geojson, Crs};
+use curbtrace_host_sim::output::geojson::write_geojson;
 use curbtrace_host_sim::pipeline;
 use curbtrace_host_sim::qiu::{extract_edges_with_report, QiuInput, QiuParams};
 use curbtrace_host_sim::simulate;
