@@ -43,7 +43,8 @@ fn main() -> anyhow::Result<()> {
     for k in 0..copies {
         let mut b = las::Builder::from(header.clone());
         b.transforms.x.offset += f64::from(k) * 2000.0;
-        let mut wr = las::Writer::from_path(out.join(format!("strip{k:04}.laz")), b.into_header()?)?;
+        let mut wr =
+            las::Writer::from_path(out.join(format!("strip{k:04}.laz")), b.into_header()?)?;
         for p in &points {
             let mut p = p.clone();
             p.x += f64::from(k) * 2000.0;

@@ -32,6 +32,6 @@ pub mod plot;
 pub mod proc_stats;
 pub mod qiu;
 pub mod replay;
+pub mod simulate;
 pub mod source;
 pub mod stream;
-pub mod simulate;

@@ -8,9 +8,9 @@ use crate::config::{Config, ConfigError};
 use crate::io::las_in::{self, LasError, LasInfo, PointColumns, ReadOptions};
 use crate::io::trajectory::{Trajectory, TrajectoryError};
 use crate::model::{Crs, EdgeLine};
+use crate::proc_stats::{peak_rss_bytes, process_cpu_s};
 use crate::replay::run::{self, KernelResults, ReplayCounters, ReplayError};
 use std::path::{Path, PathBuf};
-use crate::proc_stats::{peak_rss_bytes, process_cpu_s};
 use std::time::Instant;
 
 /// Errors of the whole extraction; every message names the file and the problem.

@@ -95,12 +95,32 @@ fn one_section_as_long_as_the_street_is_the_whole_file_run_byte_for_byte() {
     // The same counts from the core; only the packets differ (more chunks, more packets).
     let (a, b) = (&one.summary.core, &whole.summary.core);
     assert_eq!(
-        (a.points_sent, a.scanlines, a.kept, a.irregular, a.no_neighbour, a.truncated, a.lost),
-        (b.points_sent, b.scanlines, b.kept, b.irregular, b.no_neighbour, b.truncated, b.lost)
+        (
+            a.points_sent,
+            a.scanlines,
+            a.kept,
+            a.irregular,
+            a.no_neighbour,
+            a.truncated,
+            a.lost
+        ),
+        (
+            b.points_sent,
+            b.scanlines,
+            b.kept,
+            b.irregular,
+            b.no_neighbour,
+            b.truncated,
+            b.lost
+        )
     );
     assert_eq!(one.summary.candidates, whole.summary.candidates);
     // The default window: the same edges, closed section by section.
-    let def = streamed(std::slice::from_ref(&points), &traj, &WindowParams::default());
+    let def = streamed(
+        std::slice::from_ref(&points),
+        &traj,
+        &WindowParams::default(),
+    );
     assert_eq!(canonical(&def.edges), canonical(&whole.edges));
     // Short sections with a small margin do change edges: the window is what bounds them.
     let short = streamed(
@@ -131,7 +151,7 @@ fn several_files_in_any_order_and_out_of_order_files_give_the_same_edges() {
     assert_eq!(multi.summary.core, base.summary.core);
     assert!(!multi.summary.las.was_reordered);
     // The directory as input reads the same files.
-    let by_dir = streamed(&[parts_dir.clone()], &traj, &w);
+    let by_dir = streamed(std::slice::from_ref(&parts_dir), &traj, &w);
     assert_eq!(geojson(&by_dir), geojson(&base));
     // Each file stored backwards in time: detected, sorted through a temporary directory.
     let rev_dir = dir.path().join("rev");
@@ -155,8 +175,7 @@ fn bad_inputs_name_the_file() {
         &WindowParams::default(),
         &Progress::hidden(),
     )
-    .err()
-    .expect("no input is an error")
+    .expect_err("no input is an error")
     .to_string();
     assert!(err.contains("nothing-*.laz"), "{err}");
     let bad = dir.path().join("bad.laz");
@@ -169,8 +188,7 @@ fn bad_inputs_name_the_file() {
         &WindowParams::default(),
         &Progress::hidden(),
     )
-    .err()
-    .expect("a bad file is an error")
+    .expect_err("a bad file is an error")
     .to_string();
     assert!(err.contains("bad.laz"), "{err}");
 }

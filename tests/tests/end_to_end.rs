@@ -10,8 +10,8 @@ use curbtrace_host_sim::config::Config;
 use curbtrace_host_sim::eval::{evaluate, EvalParams, EvalReport};
 use curbtrace_host_sim::model::{read_geojson, Category};
 use curbtrace_host_sim::pipeline::{ExtractOptions, Progress};
-use curbtrace_host_sim::stream::{self, WindowParams};
 use curbtrace_host_sim::simulate;
+use curbtrace_host_sim::stream::{self, WindowParams};
 use std::path::Path;
 
 fn simulate_extract_eval(scene: &str, seed: u64, dir: &Path) -> EvalReport {

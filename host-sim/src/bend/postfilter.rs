@@ -16,8 +16,8 @@ use super::params::BendParams;
 use super::route::Route;
 use super::track::Track;
 use super::BendInput;
-use crate::replay::PointStatus;
 use crate::model::{Category, EdgeLine};
+use crate::replay::PointStatus;
 
 fn pos(input: &BendInput, p: u32) -> [f64; 3] {
     let i = p as usize;
@@ -356,8 +356,9 @@ fn refined_pos(input: &BendInput, p: u32) -> [f64; 3] {
     if i == 0 || i + 1 >= input.x.len() {
         return here;
     }
-    let ok =
-        |j: usize| input.status[j] == Some(PointStatus::Kept) && input.scanline[j] == input.scanline[i];
+    let ok = |j: usize| {
+        input.status[j] == Some(PointStatus::Kept) && input.scanline[j] == input.scanline[i]
+    };
     if !(ok(i - 1) && ok(i + 1)) {
         return here;
     }

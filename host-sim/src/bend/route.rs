@@ -117,22 +117,31 @@ impl Route {
         let mut best: Option<(f64, usize)> = None;
         let mut r = 2.0 * DECIMATE_M;
         while best.is_none() && r < 1e7 {
-            self.grid.for_each_within(&self.x, &self.y, q[0], q[1], r, |k| {
-                let d = (self.x[k] - q[0]).hypot(self.y[k] - q[1]);
-                if best.is_none_or(|(bd, bk)| d < bd || (d == bd && k < bk)) {
-                    best = Some((d, k));
-                }
-            });
+            self.grid
+                .for_each_within(&self.x, &self.y, q[0], q[1], r, |k| {
+                    let d = (self.x[k] - q[0]).hypot(self.y[k] - q[1]);
+                    if best.is_none_or(|(bd, bk)| d < bd || (d == bd && k < bk)) {
+                        best = Some((d, k));
+                    }
+                });
             r *= 4.0;
         }
         let (_, k0) = best?;
         let s0 = self.s[k0];
         let lo = self.s.partition_point(|&s| s < s0 - 4.0).saturating_sub(1);
-        let hi = self.s.partition_point(|&s| s <= s0 + 4.0).min(self.s.len() - 1);
+        let hi = self
+            .s
+            .partition_point(|&s| s <= s0 + 4.0)
+            .min(self.s.len() - 1);
         let mut out: Option<(f64, usize)> = None;
         for k in lo..=hi {
             let e = (k + 1).min(self.s.len() - 1);
-            let (ax, ay, dx, dy) = (self.x[k], self.y[k], self.x[e] - self.x[k], self.y[e] - self.y[k]);
+            let (ax, ay, dx, dy) = (
+                self.x[k],
+                self.y[k],
+                self.x[e] - self.x[k],
+                self.y[e] - self.y[k],
+            );
             let l2 = dx * dx + dy * dy;
             let u = if l2 > 0.0 {
                 (((q[0] - ax) * dx + (q[1] - ay) * dy) / l2).clamp(0.0, 1.0)

@@ -14,8 +14,8 @@ use super::grid::PointGrid;
 use super::params::BendParams;
 use super::seed::Seed;
 use super::BendInput;
-use crate::replay::PointStatus;
 use crate::model::Side;
+use crate::replay::PointStatus;
 
 /// One tracked edge: its vertices in order along the driving direction.
 ///

@@ -116,7 +116,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     progress.finish();
     match args.format {
-        Format::Geojson => output::geojson::write_geojson(output, &result.edges, result.crs.as_ref())?,
+        Format::Geojson => {
+            output::geojson::write_geojson(output, &result.edges, result.crs.as_ref())?
+        }
         Format::Csv => output::csv::write_edges(output, &result.edges)
             .with_context(|| format!("{}: writing the edges", output.display()))?,
     }

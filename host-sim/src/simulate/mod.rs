@@ -260,12 +260,12 @@ pub fn run(
     let crs = write::wkt_for(spec.epsg)
         .map(Crs::Wkt)
         .unwrap_or(Crs::Epsg(spec.epsg));
-    crate::output::geojson::write_geojson(&reference_path, &sim.reference, Some(&crs)).map_err(|e| {
-        SimError::Write {
+    crate::output::geojson::write_geojson(&reference_path, &sim.reference, Some(&crs)).map_err(
+        |e| SimError::Write {
             path: reference_path.display().to_string(),
             what: e.to_string(),
-        }
-    })?;
+        },
+    )?;
     let mut reference_m = [0.0; 4];
     for l in &sim.reference {
         if let Some(c) = l.category {

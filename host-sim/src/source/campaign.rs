@@ -34,7 +34,9 @@ pub enum SourceError {
         source: std::io::Error,
     },
     /// A point earlier than the one before it.
-    #[error("{path}: point at GPS time {t} s comes after one at {before} s (input not in time order)")]
+    #[error(
+        "{path}: point at GPS time {t} s comes after one at {before} s (input not in time order)"
+    )]
     OutOfOrder {
         /// The file.
         path: PathBuf,
@@ -44,7 +46,9 @@ pub enum SourceError {
         before: f64,
     },
     /// Files in different coordinate reference systems.
-    #[error("{path}: its CRS {crs:?} differs from {first_path}'s {first:?}; one run needs one CRS")]
+    #[error(
+        "{path}: its CRS {crs:?} differs from {first_path}'s {first:?}; one run needs one CRS"
+    )]
     Crs {
         /// The file that differs.
         path: PathBuf,
@@ -81,7 +85,11 @@ impl InputInfo {
     pub fn las_info(&self, selected: u64, selection: ScannerSelection, reordered: bool) -> LasInfo {
         let path = match self.files.as_slice() {
             [one] => one.clone(),
-            [first, ..] => PathBuf::from(format!("{} files from {}", self.files.len(), first.display())),
+            [first, ..] => PathBuf::from(format!(
+                "{} files from {}",
+                self.files.len(),
+                first.display()
+            )),
             [] => PathBuf::new(),
         };
         LasInfo {
@@ -245,7 +253,7 @@ impl Campaign {
 /// A source of time-ordered batches: the files as they are, or their sorted runs.
 pub enum Source {
     /// Files in time order.
-    Files(Campaign),
+    Files(Box<Campaign>),
     /// Files sorted through a temporary directory.
     Sorted(SortedRuns, InputInfo),
 }

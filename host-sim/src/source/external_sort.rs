@@ -100,7 +100,8 @@ impl SortedRuns {
             let f = File::create(&path).map_err(io_err(&path))?;
             let mut w = BufWriter::with_capacity(1 << 18, f);
             for &i in &perm {
-                w.write_all(&encode(&b, i as usize)).map_err(io_err(&path))?;
+                w.write_all(&encode(&b, i as usize))
+                    .map_err(io_err(&path))?;
             }
             w.flush().map_err(io_err(&path))?;
             total += b.len() as u64;

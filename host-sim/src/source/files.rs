@@ -65,7 +65,10 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<PathBuf>, FilesError> {
                 pattern: pattern.clone(),
                 what: e.msg.to_string(),
             })?;
-            let mut found: Vec<PathBuf> = paths.filter_map(Result::ok).filter(|p| p.is_file()).collect();
+            let mut found: Vec<PathBuf> = paths
+                .filter_map(Result::ok)
+                .filter(|p| p.is_file())
+                .collect();
             if found.is_empty() {
                 return Err(FilesError::NotFound(input.clone()));
             }
@@ -90,7 +93,9 @@ mod tests {
         }
         let got = expand(&[d.path().to_path_buf(), d.path().join("*.laz")]).unwrap();
         assert_eq!(got, vec![d.path().join("a.las"), d.path().join("b.laz")]);
-        let err = expand(&[d.path().join("nothing*.laz")]).unwrap_err().to_string();
+        let err = expand(&[d.path().join("nothing*.laz")])
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("nothing*.laz"), "{err}");
     }
 }

@@ -114,13 +114,17 @@ impl LasBatches {
     pub fn read_into(&mut self, out: &mut PointBatch, max: usize) -> Result<u64, LasError> {
         let mut decoded = 0u64;
         while decoded < max as u64 && self.done < self.total {
-            let want = self.slab.min(self.total - self.done).min(max as u64 - decoded);
-            let n = self.reader.fill_points(want.max(1), &mut self.pd).map_err(|e| {
-                LasError::Las {
+            let want = self
+                .slab
+                .min(self.total - self.done)
+                .min(max as u64 - decoded);
+            let n = self
+                .reader
+                .fill_points(want.max(1), &mut self.pd)
+                .map_err(|e| LasError::Las {
                     path: self.path.clone(),
                     what: format!("decoding points after point {}: {e}", self.done),
-                }
-            })?;
+                })?;
             if n == 0 {
                 return Err(LasError::Truncated {
                     path: self.path.clone(),
@@ -164,7 +168,9 @@ impl LasBatches {
             });
         }
         if self.scanner.is_none() {
-            let seen: Vec<u8> = (0u8..4).filter(|&c| self.channels_seen[usize::from(c)]).collect();
+            let seen: Vec<u8> = (0u8..4)
+                .filter(|&c| self.channels_seen[usize::from(c)])
+                .collect();
             if seen.len() > 1 {
                 return Err(LasError::SeveralScanners {
                     path: self.path.clone(),
@@ -183,7 +189,10 @@ impl LasBatches {
             .chunks_exact(rl)
             .zip(self.pd.point_source_id())
             .zip(self.pd.x().zip(self.pd.y()).zip(self.pd.z()))
-            .zip(gps.zip(self.pd.intensity()).zip(self.pd.scan_angle_degrees()));
+            .zip(
+                gps.zip(self.pd.intensity())
+                    .zip(self.pd.scan_angle_degrees()),
+            );
         for (k, (((rec, psid), ((x, y), z)), ((t, i), sa))) in iter.enumerate() {
             let ch = channel_of(rec);
             let keep = match sel {
@@ -217,7 +226,9 @@ impl LasBatches {
     fn finish_checks(&self) -> Result<(), LasError> {
         if let (Some(id), Some(ScannerSelection::PointSourceId(_))) = (self.scanner, self.selection)
         {
-            let channels: Vec<u8> = (0u8..4).filter(|&c| self.channels_seen[usize::from(c)]).collect();
+            let channels: Vec<u8> = (0u8..4)
+                .filter(|&c| self.channels_seen[usize::from(c)])
+                .collect();
             if self.extended && channels.iter().any(|&c| c != 0) {
                 return Err(LasError::NoPoints {
                     path: self.path.clone(),
@@ -236,10 +247,13 @@ impl LasBatches {
         let mut r = Self::open(path, &ReadOptions { scanner: None })?;
         r.slab = 1;
         let mut b = PointBatch::default();
-        let n = r.reader.fill_points(1, &mut r.pd).map_err(|e| LasError::Las {
-            path: path.to_path_buf(),
-            what: format!("decoding the first point: {e}"),
-        })?;
+        let n = r
+            .reader
+            .fill_points(1, &mut r.pd)
+            .map_err(|e| LasError::Las {
+                path: path.to_path_buf(),
+                what: format!("decoding the first point: {e}"),
+            })?;
         if n == 0 {
             return Ok(None);
         }

@@ -81,7 +81,8 @@ impl PointBatch {
         self.y.extend_from_slice(&o.y[range.clone()]);
         self.z.extend_from_slice(&o.z[range.clone()]);
         self.t.extend_from_slice(&o.t[range.clone()]);
-        self.intensity.extend_from_slice(&o.intensity[range.clone()]);
+        self.intensity
+            .extend_from_slice(&o.intensity[range.clone()]);
         self.scan_angle_deg
             .extend_from_slice(&o.scan_angle_deg[range.clone()]);
         self.channel.extend_from_slice(&o.channel[range]);

@@ -79,7 +79,9 @@ impl<'a> CoreStage<'a> {
             traj,
             words,
             params,
-            t_range: traj.time_range().unwrap_or((f64::INFINITY, f64::NEG_INFINITY)),
+            t_range: traj
+                .time_range()
+                .unwrap_or((f64::INFINITY, f64::NEG_INFINITY)),
             rule: None,
             carry: PointBatch::default(),
             next_base: 0,
@@ -106,7 +108,11 @@ impl<'a> CoreStage<'a> {
             return Ok(None);
         }
         let rule = *self.rule.get_or_insert_with(|| {
-            LineRule::choose(&self.carry.scan_angle_deg, &self.carry.t, &self.params.line())
+            LineRule::choose(
+                &self.carry.scan_angle_deg,
+                &self.carry.t,
+                &self.params.line(),
+            )
         });
         if !rule.flags_lines() {
             if self.carry.len() > UNCUT_MAX_POINTS {
@@ -137,7 +143,8 @@ impl<'a> CoreStage<'a> {
     /// Runs the first `n` carried points through the core.
     fn run(&mut self, n: usize) -> Result<CoreBatch, CoreError> {
         let rest = if n < self.carry.len() {
-            let mut r = PointBatch::with_capacity(self.carry.len() - n + super::STREAM_BATCH_POINTS);
+            let mut r =
+                PointBatch::with_capacity(self.carry.len() - n + super::STREAM_BATCH_POINTS);
             r.extend_from(&self.carry, n..self.carry.len());
             r
         } else {
@@ -159,7 +166,8 @@ impl<'a> CoreStage<'a> {
             scan_angle_deg: head.scan_angle_deg,
         };
         let rule = self.rule.unwrap_or(LineRule::None);
-        let k = run::run_kernel_with_rule(&cols, self.traj, &self.words, &self.params, &rule, &|_| {})?;
+        let k =
+            run::run_kernel_with_rule(&cols, self.traj, &self.words, &self.params, &rule, &|_| {})?;
         let base = self.next_base;
         let lines = self.lines;
         self.next_base += n as u64;

@@ -24,7 +24,9 @@ use crate::config::{Config, ConfigError};
 use crate::io::las_in::ReadOptions;
 use crate::io::trajectory::Trajectory;
 use crate::model::EdgeLine;
-use crate::pipeline::{ExtractError, ExtractOptions, ExtractResult, Method, Progress, StageTimes, Summary};
+use crate::pipeline::{
+    ExtractError, ExtractOptions, ExtractResult, Method, Progress, StageTimes, Summary,
+};
 use crate::proc_stats::{peak_rss_bytes, process_cpu_s};
 use crate::replay::run::ReplayCounters;
 use crate::source::campaign::{Campaign, Source, SourceError};
@@ -147,7 +149,9 @@ enum SourceSpec {
 impl SourceSpec {
     fn open(self) -> Result<Source, SourceError> {
         Ok(match self {
-            SourceSpec::Files(inputs, read) => Source::Files(Campaign::open(&inputs, &read)?),
+            SourceSpec::Files(inputs, read) => {
+                Source::Files(Box::new(Campaign::open(&inputs, &read)?))
+            }
             SourceSpec::Sorted(runs, info) => Source::Sorted(runs, info),
         })
     }
@@ -266,7 +270,9 @@ fn run_pass(
                 }
             }
         }
-        let selection = reader.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
+        let selection = reader
+            .join()
+            .unwrap_or_else(|p| std::panic::resume_unwind(p));
         let core_out = core.join().unwrap_or_else(|p| std::panic::resume_unwind(p));
         if let Some(e) = err {
             return Err(e);

@@ -89,8 +89,11 @@ impl Columns {
             grow(&mut self.scanline, cap);
         }
         let base = b.base;
-        self.candidates
-            .extend(b.candidates.into_iter().map(|c| (base + u64::from(c.point), c)));
+        self.candidates.extend(
+            b.candidates
+                .into_iter()
+                .map(|c| (base + u64::from(c.point), c)),
+        );
         self.x.extend(b.x);
         self.y.extend(b.y);
         self.z.extend(b.z);
@@ -209,7 +212,11 @@ impl<'a> SectionWindow<'a> {
         let (s0, s1) = (k as f64 * l, (k + 1) as f64 * l);
         let lo = self.cols.t.partition_point(|&t| self.station(t) < s0 - m);
         let hi = self.cols.t.partition_point(|&t| self.station(t) < s1 + m);
-        let edges = if hi > lo { self.extract_range(lo, hi) } else { Vec::new() };
+        let edges = if hi > lo {
+            self.extract_range(lo, hi)
+        } else {
+            Vec::new()
+        };
         let mut pieces = Vec::new();
         for (e, steps) in edges {
             pieces.extend(cut_to_section(&self.route, e, steps, s0, s1));
@@ -245,7 +252,7 @@ impl<'a> SectionWindow<'a> {
             candidates: &cands,
             trajectory: self.traj,
         };
-        bend::extract_edges_with_steps(&input, &self.bend)
+        bend::extract_edges_on_route(&input, &self.route, &self.bend)
     }
 }
 
