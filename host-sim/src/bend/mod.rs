@@ -89,13 +89,22 @@ pub fn extract_edges_with_steps(
     input: &BendInput,
     params: &BendParams,
 ) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
+    extract_edges_on_route(input, &route::Route::new(input.trajectory), params)
+}
+
+/// [`extract_edges_with_steps`] on a route built once from `input.trajectory` (a stream
+/// runs many windows over one trajectory).
+pub fn extract_edges_on_route(
+    input: &BendInput,
+    route: &route::Route,
+    params: &BendParams,
+) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
     let input = input.truncated();
-    let route = route::Route::new(input.trajectory);
     // One index over every processed point: tracking reads the kept ones, the vehicle
     // filter and the height step read all.
     let cell_m = params.search_radius_m.clamp(0.05, 1.0);
     let grid = grid::PointGrid::build(input.x, input.y, cell_m, |i| input.status[i].is_some());
-    let mut seeds = seed::seed_points(&input, &route, params);
+    let mut seeds = seed::seed_points(&input, route, params);
     // Best-fitting seeds first: the first track along a curb claims it, later seeds on the
     // same curb start nothing.
     seeds.sort_by(|a, b| {
@@ -109,11 +118,11 @@ pub fn extract_edges_with_steps(
     let tracks = postfilter::remove_short(&input, tracks, params);
     let tracks = postfilter::remove_under_objects(&input, &grid, tracks, params);
     let tracks = if params.roadway_filter {
-        postfilter::remove_outside_roadway(&input, &route, tracks)
+        postfilter::remove_outside_roadway(&input, route, tracks)
     } else {
         tracks
     };
-    postfilter::to_edge_lines_with_steps(&input, &grid, &route, &tracks, params)
+    postfilter::to_edge_lines_with_steps(&input, &grid, route, &tracks, params)
 }
 
 #[cfg(test)]

@@ -252,7 +252,7 @@ impl<'a> SectionWindow<'a> {
             candidates: &cands,
             trajectory: self.traj,
         };
-        bend::extract_edges_with_steps(&input, &self.bend)
+        bend::extract_edges_on_route(&input, &self.route, &self.bend)
     }
 }
 
