@@ -8,7 +8,6 @@
 //! [`external_sort::SortedRuns`](super::external_sort::SortedRuns), which sorts chunk-wise
 //! through a temporary directory in bounded memory.
 
-use super::external_sort::SortedRuns;
 use super::files::{self, FilesError};
 use super::las_batches::LasBatches;
 use super::PointBatch;
@@ -253,47 +252,5 @@ impl Campaign {
             self.last_t = t;
         }
         Ok(())
-    }
-}
-
-/// A source of time-ordered batches: the files as they are, or their sorted runs.
-pub enum Source {
-    /// Files in time order.
-    Files(Box<Campaign>),
-    /// Files sorted through a temporary directory.
-    Sorted(SortedRuns, InputInfo),
-}
-
-impl Source {
-    /// The next batch of up to about `max` points; `None` at the end.
-    pub fn next_batch(&mut self, max: usize) -> Result<Option<PointBatch>, SourceError> {
-        match self {
-            Source::Files(c) => c.next_batch(max),
-            Source::Sorted(s, _) => s.next_batch(max),
-        }
-    }
-
-    /// Bytes of the inputs consumed so far (for the progress bar).
-    pub fn bytes_done(&self) -> u64 {
-        match self {
-            Source::Files(c) => c.bytes_done(),
-            Source::Sorted(s, info) => s.bytes_done(info.bytes),
-        }
-    }
-
-    /// The inputs' header facts.
-    pub fn info(&self) -> &InputInfo {
-        match self {
-            Source::Files(c) => c.info(),
-            Source::Sorted(_, info) => info,
-        }
-    }
-
-    /// The scanner selection in force.
-    pub fn selection(&self) -> ScannerSelection {
-        match self {
-            Source::Files(c) => c.selection(),
-            Source::Sorted(s, _) => s.selection,
-        }
     }
 }

@@ -17,6 +17,10 @@ pub mod external_sort;
 pub mod files;
 pub mod las_batches;
 
+use crate::io::las_in::ScannerSelection;
+use campaign::{Campaign, InputInfo, SourceError};
+use external_sort::SortedRuns;
+
 /// Points per batch handed downstream and per decoded slab: 2^17 points are a few LAZ
 /// chunks for the parallel decoder and about 6 MB of columns.
 pub const BATCH_POINTS: usize = 1 << 15;
@@ -102,5 +106,47 @@ impl PointBatch {
     /// True when the times never decrease.
     pub fn is_time_ordered(&self) -> bool {
         self.t.windows(2).all(|w| w[0] <= w[1])
+    }
+}
+
+/// A source of time-ordered batches: the files as they are, or their sorted runs.
+pub enum Source {
+    /// Files in time order.
+    Files(Box<Campaign>),
+    /// Files sorted through a temporary directory.
+    Sorted(SortedRuns, InputInfo),
+}
+
+impl Source {
+    /// The next batch of up to about `max` points; `None` at the end.
+    pub fn next_batch(&mut self, max: usize) -> Result<Option<PointBatch>, SourceError> {
+        match self {
+            Source::Files(c) => c.next_batch(max),
+            Source::Sorted(s, _) => s.next_batch(max),
+        }
+    }
+
+    /// Bytes of the inputs consumed so far (for the progress bar).
+    pub fn bytes_done(&self) -> u64 {
+        match self {
+            Source::Files(c) => c.bytes_done(),
+            Source::Sorted(s, info) => s.bytes_done(info.bytes),
+        }
+    }
+
+    /// The inputs' header facts.
+    pub fn info(&self) -> &InputInfo {
+        match self {
+            Source::Files(c) => c.info(),
+            Source::Sorted(_, info) => info,
+        }
+    }
+
+    /// The scanner selection in force.
+    pub fn selection(&self) -> ScannerSelection {
+        match self {
+            Source::Files(c) => c.selection(),
+            Source::Sorted(s, _) => s.selection,
+        }
     }
 }

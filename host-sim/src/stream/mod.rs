@@ -29,8 +29,9 @@ use crate::pipeline::{
 };
 use crate::proc_stats::{peak_rss_bytes, process_cpu_s};
 use crate::replay::run::ReplayCounters;
-use crate::source::campaign::{Campaign, Source, SourceError};
+use crate::source::campaign::{Campaign, SourceError};
 use crate::source::external_sort::{SortedRuns, RUN_POINTS};
+use crate::source::Source;
 use crate::source::{PointBatch, BATCH_POINTS};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
