@@ -24,6 +24,7 @@ pub mod config;
 pub mod eval;
 pub mod io;
 pub mod model;
+pub mod output;
 pub mod pipeline;
 pub mod plot;
 pub mod qiu;
