@@ -78,6 +78,12 @@ fn ogrinfo(path: &Path, summary: bool) -> String {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(out.status.success(), "ogrinfo {}:\n{text}", path.display());
+    // A file GDAL reads with a warning or an error is not a clean file.
+    assert!(
+        !text.contains("Warning") && !text.contains("ERROR"),
+        "ogrinfo {}:\n{text}",
+        path.display()
+    );
     text
 }
 
@@ -114,7 +120,9 @@ fn every_format_opens_in_gdal_with_its_driver_count_and_crs() {
     let custom = UTM33_WKT
         .replace("WGS 84 / UTM zone 33N", "site TM")
         .replace(r#",AUTHORITY["EPSG","32633"]]"#, "]");
-    let cases: [(&str, Option<Crs>, f64, f64, Option<&str>); 4] = [
+    // (name, CRS, origin x, origin y, text the CRS block of GPKG and FGB must hold)
+    type Case<'a> = (&'a str, Option<Crs>, f64, f64, Option<&'a str>);
+    let cases: [Case; 4] = [
         (
             "epsg",
             Some(Crs::Epsg(6677)),
@@ -194,7 +202,7 @@ fn every_format_opens_in_gdal_with_its_driver_count_and_crs() {
 }
 
 /// The block ogrinfo prints for the feature whose line starts at `p`.
-fn feature_block<'a>(info: &'a str, p: [f64; 3]) -> Option<&'a str> {
+fn feature_block(info: &str, p: [f64; 3]) -> Option<&str> {
     let first = format!("LINESTRING Z ({} {} {},", p[0], p[1], p[2]);
     info.split("OGRFeature(").find(|b| b.contains(&first))
 }

@@ -1,4 +1,4 @@
-//! Edges as an OGC GeoPackage (version 1.4): an SQLite file with the three mandatory tables
+//! Edges as an OGC GeoPackage (1.2): an SQLite file with the three mandatory tables
 //! (`gpkg_spatial_ref_sys`, `gpkg_contents`, `gpkg_geometry_columns`) and one feature table
 //! `edges` of LineString Z geometries in the LAS CRS.
 //!
@@ -14,17 +14,18 @@ use std::path::Path;
 
 /// `PRAGMA application_id` of a GeoPackage: ASCII "GPKG".
 const APPLICATION_ID: i32 = 0x4750_4B47;
-/// `PRAGMA user_version` of a GeoPackage 1.4.0 file.
-const USER_VERSION: i32 = 10400;
+/// `PRAGMA user_version`: GeoPackage 1.2.0. The file uses nothing newer, and older readers
+/// (GDAL 3.6) warn about a newer version number.
+const USER_VERSION: i32 = 10200;
 /// The name of the feature table.
 pub const TABLE: &str = "edges";
 /// srs_id of a CRS given as WKT without an EPSG code (GDAL's range for user systems).
 const CUSTOM_SRS_ID: i32 = 100_000;
 
-/// The WGS 84 row every GeoPackage holds (GeoPackage 1.4 requirement 11).
+/// The WGS 84 row every GeoPackage holds (GeoPackage requirement 11).
 const WGS84_WKT: &str = r#"GEOGCS["WGS 84",DATUM["WGS_1984",SPHEROID["WGS 84",6378137,298.257223563,AUTHORITY["EPSG","7030"]],AUTHORITY["EPSG","6326"]],PRIMEM["Greenwich",0,AUTHORITY["EPSG","8901"]],UNIT["degree",0.0174532925199433,AUTHORITY["EPSG","9122"]],AXIS["Latitude",NORTH],AXIS["Longitude",EAST],AUTHORITY["EPSG","4326"]]"#;
 
-/// The schema of a GeoPackage's mandatory tables (GeoPackage 1.4, annex C).
+/// The schema of a GeoPackage's mandatory tables (GeoPackage annex C).
 const CORE_TABLES: &str = "
 CREATE TABLE gpkg_spatial_ref_sys (
   srs_name TEXT NOT NULL,
