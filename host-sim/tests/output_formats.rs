@@ -2,8 +2,8 @@
 //! `ogrinfo` with its own driver, the right feature count and (GeoPackage, FlatGeobuf) the
 //! right CRS; the CLI chooses the format by the extension of `-o`.
 //!
-//! Needs `ogrinfo` (Debian package `gdal-bin`, installed by `scripts/test.sh`): the tests fail
-//! when it is missing.
+//! Needs `ogrinfo` (Debian package `gdal-bin`) and GDAL's GeoPackage validator (Debian package
+//! `python3-gdal`), both installed by `scripts/test.sh`: the tests fail when they are missing.
 
 use curbtrace_host_sim::model::{
     read_geojson, Category, Crs, EdgeLine, Side, SCHEMA_MEMBER, SCHEMA_VERSION,
@@ -265,6 +265,39 @@ fn the_binary_formats_keep_every_property_and_vertex() {
                 }
             }
         }
+    }
+}
+
+#[test]
+fn geopackages_pass_gdals_validator() {
+    let dir = tempfile::tempdir().unwrap();
+    let custom = Crs::Wkt(r#"LOCAL_CS["site grid",UNIT["metre",1]]"#.into());
+    let cases = [
+        ("epsg", edges(-8_000.0, -38_000.0), Some(Crs::Epsg(6677))),
+        (
+            "wkt",
+            edges(500_000.0, 5_000_000.0),
+            Some(Crs::Wkt(UTM33_WKT.into())),
+        ),
+        ("local", edges(0.0, 0.0), Some(custom)),
+        ("none", edges(0.0, 0.0), None),
+        ("empty", Vec::new(), Some(Crs::Epsg(6677))),
+    ];
+    for (tag, lines, crs) in cases {
+        let path = dir.path().join(format!("{tag}.gpkg"));
+        write_edges(&path, &lines, crs.as_ref()).unwrap();
+        let out = Command::new("/usr/bin/python3")
+            .args(["-m", "osgeo_utils.samples.validate_gpkg"])
+            .args(["--extra", "--warning-as-error"])
+            .arg(&path)
+            .output()
+            .unwrap_or_else(|e| panic!("python3 could not run ({e}): install python3-gdal"));
+        assert!(
+            out.status.success(),
+            "{tag}: validate_gpkg (Debian package python3-gdal):\n{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
 }
 
