@@ -1,4 +1,4 @@
-//! Edges as AutoCAD DXF (ASCII, R2000): one 3D POLYLINE per edge, in the LAS coordinates,
+//! Edges as AutoCAD DXF (ASCII, R12): one 3D POLYLINE per edge, in the LAS coordinates,
 //! on one layer per line kind and class (`TOE_CURB`, `TOE_CURB_CUT`, `TOE_INTERSECTION`,
 //! `TOE_BUS_BAY`, `TOE_UNCLASSIFIED`). DXF has no place for a CRS: the file opens with DXF
 //! comment groups (code 999) naming the schema version and the CRS.
@@ -58,7 +58,9 @@ fn header_comments(crs: Option<&Crs>) -> Vec<String> {
 pub fn write_dxf(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<(), OutputError> {
     let enc = |e: dxf::DxfError| OutputError::encode(path, OutputFormat::Dxf, e);
     let mut drawing = Drawing::new();
-    drawing.header.version = AcadVersion::R2000;
+    // R12 needs no table handles; the crate writes the tables of R13 and later without the
+    // handles those versions require, which CAD programs must then repair.
+    drawing.header.version = AcadVersion::R12;
     let classes = Category::ALL.into_iter().map(Some).chain([None]);
     for class in classes {
         drawing.add_layer(Layer {
