@@ -13,8 +13,10 @@ need_apt=()
 command -v /usr/bin/rustc >/dev/null 2>&1 && [ -d /usr/lib/rustlib/src/rust/library ] || need_apt+=(rustc-web cargo-web rust-web-src)
 command -v ld.lld-19 >/dev/null 2>&1 || need_apt+=(lld-19)
 command -v qemu-system-arm >/dev/null 2>&1 || need_apt+=(qemu-system-arm)
+command -v ogrinfo >/dev/null 2>&1 || need_apt+=(gdal-bin)
+/usr/bin/python3 -c 'import osgeo_utils' >/dev/null 2>&1 || need_apt+=(python3-gdal)
 if [ ${#need_apt[@]} -gt 0 ]; then
-  step "installing ${need_apt[*]} (Debian packages for the Cortex-M4F build and QEMU)"
+  step "installing ${need_apt[*]} (Debian packages for the Cortex-M4F build, QEMU, and GDAL's ogrinfo and GeoPackage validator for the output-format tests)"
   export DEBIAN_FRONTEND=noninteractive
   apt-get update -qq
   apt-get install -y -qq "${need_apt[@]}" >/dev/null

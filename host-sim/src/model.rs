@@ -167,6 +167,7 @@ pub fn read_geojson(path: &std::path::Path) -> Result<(Vec<EdgeLine>, Option<Crs
     if v.get("type").and_then(|t| t.as_str()) != Some("FeatureCollection") {
         return Err(fmt("not a GeoJSON FeatureCollection".into()));
     }
+    check_schema_version(&v).map_err(fmt)?;
     let crs = v
         .get("crs")
         .and_then(|c| c.get("properties"))
@@ -257,6 +258,38 @@ pub fn read_geojson(path: &std::path::Path) -> Result<(Vec<EdgeLine>, Option<Crs
         }
     }
     Ok((out, crs))
+}
+
+/// The top-level member of a curbtrace GeoJSON file that holds its schema version, as the
+/// string `"MAJOR.MINOR"` (`docs/output-formats.md`).
+pub const SCHEMA_MEMBER: &str = "curbtrace_schema_version";
+
+/// The schema version this build writes, `(major, minor)`. A minor step only adds optional
+/// members or properties; a major step changes or removes one. Readers take any minor of
+/// their major and refuse a newer major.
+pub const SCHEMA_VERSION: (u32, u32) = (1, 0);
+
+/// Checks the schema version of a parsed FeatureCollection: none (files from other tools,
+/// reference files) or one of this build's major version passes; a newer major or a
+/// malformed version is refused with a message saying why.
+pub fn check_schema_version(fc: &serde_json::Value) -> Result<(), String> {
+    let Some(v) = fc.get(SCHEMA_MEMBER) else {
+        return Ok(());
+    };
+    let text = v.as_str().unwrap_or_default();
+    let major = text
+        .split_once('.')
+        .and_then(|(ma, mi)| mi.parse::<u32>().ok().and(ma.parse::<u32>().ok()));
+    match major {
+        Some(m) if m <= SCHEMA_VERSION.0 => Ok(()),
+        Some(_) => Err(format!(
+            "{SCHEMA_MEMBER} {text} is newer than this curbtrace reads ({}.x): update curbtrace",
+            SCHEMA_VERSION.0
+        )),
+        None => Err(format!(
+            "{SCHEMA_MEMBER} must be a string \"MAJOR.MINOR\", found {v}"
+        )),
+    }
 }
 
 #[cfg(test)]

@@ -4,19 +4,37 @@
 
 use anyhow::Context;
 use curbtrace_host_sim::config::Config;
-use curbtrace_host_sim::output;
+use curbtrace_host_sim::output::format::{resolve, write_edges_as, OutputFormat};
 use curbtrace_host_sim::pipeline::{self, ExtractOptions, Method, Progress};
 use curbtrace_host_sim::stream::{self, WindowParams};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
-/// Output format of the edges.
+/// Output format of the edges (`--format`); without it the extension of `-o` decides.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
     /// GeoJSON FeatureCollection with the LAS CRS (docs/spec.md §3).
     Geojson,
     /// Plain vertex lists: `edge,side,vertex,x,y,z`.
     Csv,
+    /// OGC GeoPackage with the LAS CRS.
+    Gpkg,
+    /// FlatGeobuf with the LAS CRS.
+    Fgb,
+    /// AutoCAD DXF, 3D polylines on one layer per class.
+    Dxf,
+}
+
+impl From<Format> for OutputFormat {
+    fn from(f: Format) -> Self {
+        match f {
+            Format::Geojson => OutputFormat::GeoJson,
+            Format::Csv => OutputFormat::Csv,
+            Format::Gpkg => OutputFormat::GeoPackage,
+            Format::Fgb => OutputFormat::FlatGeobuf,
+            Format::Dxf => OutputFormat::Dxf,
+        }
+    }
 }
 
 /// Method names on the command line.
@@ -38,7 +56,8 @@ pub struct Args {
     /// Trajectory CSV: time,x,y,z,roll,pitch,heading (GPS time in the LAS time base).
     #[arg(long, required_unless_present = "print_config")]
     pub trajectory: Option<PathBuf>,
-    /// Output file (GeoJSON, or CSV with --format csv).
+    /// Output file; its extension chooses the format: .geojson/.json, .csv, .gpkg, .fgb, .dxf
+    /// (docs/output-formats.md).
     #[arg(short, long, required_unless_present = "print_config")]
     pub output: Option<PathBuf>,
     /// Method.
@@ -50,9 +69,9 @@ pub struct Args {
     /// TOML file with parameters (see --print-config).
     #[arg(long)]
     pub config: Option<PathBuf>,
-    /// Output format.
-    #[arg(long, value_enum, default_value = "geojson")]
-    pub format: Format,
+    /// Output format, when the extension of -o does not say it (must agree when it does).
+    #[arg(long, value_enum)]
+    pub format: Option<Format>,
     /// Prints the configuration in force (defaults, or --config's) as TOML and exits.
     #[arg(long)]
     pub print_config: bool,
@@ -86,6 +105,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     else {
         anyhow::bail!("POINTS, --trajectory and -o are required");
     };
+    // Before the work: a bad output name fails at once.
+    let format = resolve(output, args.format.map(OutputFormat::from))?;
     let opts = ExtractOptions {
         scanner: args.scanner,
         method: match args.method {
@@ -115,7 +136,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
     };
     progress.finish();
-    if let (Format::Geojson, None) = (args.format, &result.crs) {
+    if result.crs.is_none() && format != OutputFormat::Csv {
         let why = result.summary.las.no_crs.map_or_else(
             || "the input's CRS was not kept".to_string(),
             |w| w.to_string(),
@@ -126,13 +147,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             result.summary.las.path.display()
         );
     }
-    match args.format {
-        Format::Geojson => {
-            output::geojson::write_geojson(output, &result.edges, result.crs.as_ref())?
-        }
-        Format::Csv => output::csv::write_edges(output, &result.edges)
-            .with_context(|| format!("{}: writing the edges", output.display()))?,
-    }
+    write_edges_as(format, output, &result.edges, result.crs.as_ref())?;
     if !args.quiet {
         eprintln!("{}", result.summary.to_text());
         eprintln!("written            {}", output.display());

@@ -1,6 +1,6 @@
 //! Edges as a GeoJSON FeatureCollection with the legacy `crs` member (docs/spec.md §3).
 
-use crate::model::{Crs, EdgeLine, GeoJsonError};
+use crate::model::{Crs, EdgeLine, GeoJsonError, SCHEMA_MEMBER, SCHEMA_VERSION};
 
 /// Serialises lines as a GeoJSON FeatureCollection with the legacy `crs` member.
 pub fn lines_to_geojson(lines: &[EdgeLine], crs: Option<&Crs>) -> serde_json::Value {
@@ -40,6 +40,10 @@ pub fn lines_to_geojson(lines: &[EdgeLine], crs: Option<&Crs>) -> serde_json::Va
         .collect();
     let mut fc = Map::new();
     fc.insert("type".into(), json!("FeatureCollection"));
+    fc.insert(
+        SCHEMA_MEMBER.into(),
+        json!(format!("{}.{}", SCHEMA_VERSION.0, SCHEMA_VERSION.1)),
+    );
     if let Some(crs) = crs {
         let name = match crs {
             Crs::Epsg(code) => format!("urn:ogc:def:crs:EPSG::{code}"),
