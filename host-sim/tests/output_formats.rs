@@ -8,7 +8,8 @@
 use curbtrace_host_sim::model::{
     read_geojson, Category, Crs, EdgeLine, Side, SCHEMA_MEMBER, SCHEMA_VERSION,
 };
-use curbtrace_host_sim::output::format::{write_edges, OutputFormat};
+use curbtrace_host_sim::output::format::OutputFormat;
+use curbtrace_host_sim::output::write_edges;
 use std::path::Path;
 use std::process::Command;
 

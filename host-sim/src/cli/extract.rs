@@ -4,7 +4,8 @@
 
 use anyhow::Context;
 use curbtrace_host_sim::config::Config;
-use curbtrace_host_sim::output::format::{resolve, write_edges_as, OutputFormat};
+use curbtrace_host_sim::output::format::{resolve, OutputFormat};
+use curbtrace_host_sim::output::write_edges_as;
 use curbtrace_host_sim::pipeline::{self, ExtractOptions, Method, Progress};
 use curbtrace_host_sim::stream::{self, WindowParams};
 use std::io::IsTerminal;

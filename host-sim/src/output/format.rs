@@ -1,7 +1,7 @@
 //! The choice of an output format by the extension of the output path, and the one entry
 //! point that writes edges in it (`docs/output-formats.md`).
 
-use crate::model::{Crs, EdgeLine, GeoJsonError};
+use crate::model::GeoJsonError;
 use std::path::Path;
 
 /// A file format the edges can be written in.
@@ -178,29 +178,6 @@ pub fn resolve(path: &Path, flag: Option<OutputFormat>) -> Result<OutputFormat, 
         }),
         // An explicit --format covers any file name (`-o edges.txt --format csv`).
         (Some(f), Err(_)) => Ok(f),
-    }
-}
-
-/// Writes `edges` to `path` in the format its extension names (see [`OutputFormat::from_path`]).
-pub fn write_edges(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<(), OutputError> {
-    write_edges_as(OutputFormat::from_path(path)?, path, edges, crs)
-}
-
-/// Writes `edges` to `path` in `format`, whatever the extension.
-pub fn write_edges_as(
-    format: OutputFormat,
-    path: &Path,
-    edges: &[EdgeLine],
-    crs: Option<&Crs>,
-) -> Result<(), OutputError> {
-    match format {
-        OutputFormat::GeoJson => Ok(crate::output::geojson::write_geojson(path, edges, crs)?),
-        OutputFormat::Csv => {
-            crate::output::csv::write_edges(path, edges).map_err(|e| OutputError::io(path, e))
-        }
-        OutputFormat::GeoPackage => super::gpkg::write_gpkg(path, edges, crs),
-        OutputFormat::FlatGeobuf => super::fgb::write_fgb(path, edges, crs),
-        OutputFormat::Dxf => super::dxf::write_dxf(path, edges, crs),
     }
 }
 
