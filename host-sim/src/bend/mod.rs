@@ -10,9 +10,11 @@ use crate::io::trajectory::Trajectory;
 use crate::model::EdgeLine;
 use crate::replay::{Candidate, PointStatus};
 
+pub mod claims;
 pub mod grid;
 pub mod params;
 pub mod postfilter;
+pub mod profile;
 pub mod route;
 pub mod seed;
 pub mod track;

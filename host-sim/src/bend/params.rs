@@ -73,7 +73,7 @@ pub struct BendParams {
     pub max_gap_steps: u32,
     /// Whether a step whose search set S holds no point with ρ at or above `stop_rho_deg`
     /// looks for the toe on a virtual profile across the search direction, built from the
-    /// points of several scanlines (`track::profile_toe`), before it counts as a gap. Not in
+    /// points of several scanlines (`profile::profile_toe`), before it counts as a gap. Not in
     /// the paper: its ρ is taken along each scanline, so it flattens where a curb turns to
     /// run along the scanlines (intersection corners and side streets), while the height
     /// step is still there between the scanlines.
