@@ -44,14 +44,6 @@ pub enum ExtractError {
         /// The cause.
         what: String,
     },
-    /// No point lies within the trajectory's time range.
-    #[error("{points}: no point lies within the time range of the trajectory {trajectory}")]
-    NoCoverage {
-        /// The (first) point file.
-        points: PathBuf,
-        /// The trajectory.
-        trajectory: PathBuf,
-    },
     /// A method that is not part of this build.
     #[error("method {0:?} is not available in this build")]
     Method(String),

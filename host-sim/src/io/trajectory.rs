@@ -315,31 +315,44 @@ impl Trajectory {
         let covered = end - start;
         if t.is_empty() || (covered as f64) < MIN_COVERED_FRACTION * t.len() as f64 || covered == 0
         {
-            let (p0, p1) = (
-                t.first().copied().unwrap_or(f64::NAN),
-                t.last().copied().unwrap_or(f64::NAN),
-            );
-            let week = |x: f64| (0.0..GPS_WEEK_S).contains(&x);
-            let hint = if week(p0) && week(p1) && !week(t0) {
-                "; the point times look like GPS week seconds and the trajectory's do not (convert one to the other's time base)".to_string()
-            } else if week(t0) && week(t1) && !week(p0) {
-                "; the trajectory times look like GPS week seconds and the points' do not (convert one to the other's time base)".to_string()
-            } else {
-                String::new()
-            };
-            return Err(TrajectoryError::NotCovering {
-                traj: traj_path.to_path_buf(),
-                points: points_path.to_path_buf(),
-                t0,
-                t1,
-                p0,
-                p1,
-                covered,
-                n: t.len(),
-                hint,
-            });
+            let p0 = t.first().copied().unwrap_or(f64::NAN);
+            let p1 = t.last().copied().unwrap_or(f64::NAN);
+            return Err(self.not_covering(traj_path, points_path, (p0, p1), covered, t.len()));
         }
         Ok(cov)
+    }
+
+    /// The error for points (times `p0..=p1`, `covered` of `n` inside this trajectory's
+    /// time range) that do not belong to this trajectory: both time ranges, and a guess at
+    /// the cause when one side looks like GPS week seconds and the other does not.
+    pub fn not_covering(
+        &self,
+        traj_path: &Path,
+        points_path: &Path,
+        (p0, p1): (f64, f64),
+        covered: usize,
+        n: usize,
+    ) -> TrajectoryError {
+        let (t0, t1) = self.time_range().unwrap_or((f64::NAN, f64::NAN));
+        let week = |x: f64| (0.0..GPS_WEEK_S).contains(&x);
+        let hint = if week(p0) && week(p1) && !week(t0) {
+            "; the point times look like GPS week seconds and the trajectory's do not (convert one to the other's time base)".to_string()
+        } else if week(t0) && week(t1) && !week(p0) {
+            "; the trajectory times look like GPS week seconds and the points' do not (convert one to the other's time base)".to_string()
+        } else {
+            String::new()
+        };
+        TrajectoryError::NotCovering {
+            traj: traj_path.to_path_buf(),
+            points: points_path.to_path_buf(),
+            t0,
+            t1,
+            p0,
+            p1,
+            covered,
+            n,
+            hint,
+        }
     }
 }
 

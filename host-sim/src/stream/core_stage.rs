@@ -9,7 +9,6 @@
 //! itself, which needs the stream uncut: the points are then held until the end, up to
 //! [`UNCUT_MAX_POINTS`].
 
-use crate::io::las_in::PointColumns;
 use crate::io::trajectory::Trajectory;
 use crate::replay::line_start::LineRule;
 use crate::replay::run::{self, ReplayCounters, ReplayError, ReplayParams};
@@ -70,6 +69,8 @@ pub struct CoreStage<'a> {
     pub dropped: (u64, u64),
     /// Points kept.
     pub points: u64,
+    /// Times of the first and the last point read, before the trajectory's cut.
+    pub time_span: Option<(f64, f64)>,
 }
 
 impl<'a> CoreStage<'a> {
@@ -89,11 +90,17 @@ impl<'a> CoreStage<'a> {
             counters: ReplayCounters::default(),
             dropped: (0, 0),
             points: 0,
+            time_span: None,
         }
     }
 
     /// Takes a batch; returns the core's output for the whole lines it completes.
     pub fn push(&mut self, b: PointBatch) -> Result<Option<CoreBatch>, CoreError> {
+        if let (Some(&first), Some(&last)) = (b.t.first(), b.t.last()) {
+            let (a, z) = self.time_span.get_or_insert((first, last));
+            *a = a.min(first);
+            *z = z.max(last);
+        }
         let (t0, t1) = self.t_range;
         let lo = b.t.partition_point(|&t| t < t0);
         let hi = b.t.partition_point(|&t| t <= t1).max(lo);
@@ -150,21 +157,8 @@ impl<'a> CoreStage<'a> {
         } else {
             PointBatch::default()
         };
-        let mut head = std::mem::replace(&mut self.carry, rest);
-        head.x.truncate(n);
-        head.y.truncate(n);
-        head.z.truncate(n);
-        head.t.truncate(n);
-        head.intensity.truncate(n);
-        head.scan_angle_deg.truncate(n);
-        let cols = PointColumns {
-            x: head.x,
-            y: head.y,
-            z: head.z,
-            t: head.t,
-            intensity: head.intensity,
-            scan_angle_deg: head.scan_angle_deg,
-        };
+        let mut cols = std::mem::replace(&mut self.carry, rest);
+        cols.keep_range(0..n);
         let rule = self.rule.unwrap_or(LineRule::None);
         let k =
             run::run_kernel_with_rule(&cols, self.traj, &self.words, &self.params, &rule, &|_| {})?;

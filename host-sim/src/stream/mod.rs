@@ -22,7 +22,7 @@ pub mod window;
 
 use crate::config::{Config, ConfigError};
 use crate::io::las_in::ReadOptions;
-use crate::io::trajectory::Trajectory;
+use crate::io::trajectory::{Trajectory, MIN_COVERED_FRACTION};
 use crate::model::EdgeLine;
 use crate::pipeline::{
     ExtractError, ExtractOptions, ExtractResult, Method, Progress, StageTimes, Summary,
@@ -48,6 +48,7 @@ struct Pass {
     counters: ReplayCounters,
     dropped: (u64, u64),
     points: u64,
+    time_span: Option<(f64, f64)>,
     candidates: u64,
     peak_window_points: usize,
     times: StageTimes,
@@ -107,11 +108,16 @@ pub fn extract(
         }
     };
     let (mut pass, selection) = pass;
-    if pass.points == 0 {
-        return Err(ExtractError::NoCoverage {
-            points: first,
-            trajectory: traj_path.to_path_buf(),
-        });
+    let read = pass.points + pass.dropped.0 + pass.dropped.1;
+    if pass.points == 0 || (pass.points as f64) < MIN_COVERED_FRACTION * read as f64 {
+        let span = pass.time_span.unwrap_or((f64::NAN, f64::NAN));
+        return Err(ExtractError::Trajectory(traj.not_covering(
+            traj_path,
+            &first,
+            span,
+            pass.points as usize,
+            read as usize,
+        )));
     }
     for e in &mut pass.edges {
         e.method
@@ -249,7 +255,7 @@ fn run_pass(
             }
             busy += t0.elapsed().as_secs_f64();
             core_s.store(busy.to_bits(), Ordering::Relaxed);
-            Some((stage.counters, stage.dropped, stage.points))
+            Some((stage.counters, stage.dropped, stage.points, stage.time_span))
         });
         let mut win = window::SectionWindow::new(traj, *window, cfg.bend.clone());
         let mut edges = Vec::new();
@@ -278,7 +284,7 @@ fn run_pass(
         if let Some(e) = err {
             return Err(e);
         }
-        let Some((counters, dropped, points)) = core_out else {
+        let Some((counters, dropped, points, time_span)) = core_out else {
             return Err(PassError::Core(core_stage::CoreError::Replay(
                 crate::replay::run::ReplayError::Stalled,
             )));
@@ -299,6 +305,7 @@ fn run_pass(
                 counters,
                 dropped,
                 points,
+                time_span,
                 candidates,
                 peak_window_points: win.peak_points,
                 times,

@@ -1,7 +1,7 @@
 //! The points as columns, and the decoding of raw point records into them.
 //!
-//! Columns: x, y, z, t as `f64` (32 B), intensity `u16` (2 B), scan angle `f32` (4 B):
-//! 38 B per selected point.
+//! Columns: x, y, z, t as `f64` (32 B), intensity `u16` (2 B), scan angle `f32` (4 B),
+//! scanner channel `u8` (1 B): 39 B per selected point.
 
 /// The selected points as columns, sorted by GPS time (stable: equal times keep file
 /// order). Index `i` of every column is point `i`, the tag the core carries.
@@ -19,6 +19,8 @@ pub struct PointColumns {
     pub intensity: Vec<u16>,
     /// Scan angle, degrees (legacy formats: whole degrees; 6–10: 0.006° steps).
     pub scan_angle_deg: Vec<f32>,
+    /// Channel key: the LAS 1.4 scanner channel (formats 6–10), 0 in legacy formats.
+    pub channel: Vec<u8>,
 }
 
 impl PointColumns {
@@ -37,7 +39,8 @@ impl PointColumns {
         Some((*self.t.first()?, *self.t.last()?))
     }
 
-    pub(super) fn with_capacity(n: usize) -> Self {
+    /// Empty columns with room for `n` points.
+    pub fn with_capacity(n: usize) -> Self {
         Self {
             x: Vec::with_capacity(n),
             y: Vec::with_capacity(n),
@@ -45,6 +48,7 @@ impl PointColumns {
             t: Vec::with_capacity(n),
             intensity: Vec::with_capacity(n),
             scan_angle_deg: Vec::with_capacity(n),
+            channel: Vec::with_capacity(n),
         }
     }
 
@@ -55,16 +59,55 @@ impl PointColumns {
         self.t.shrink_to_fit();
         self.intensity.shrink_to_fit();
         self.scan_angle_deg.shrink_to_fit();
+        self.channel.shrink_to_fit();
     }
 
-    /// Appends one point.
-    pub(super) fn push(&mut self, x: f64, y: f64, z: f64, t: f64, intensity: u16, sa: f32) {
+    /// Appends one point: position, time, intensity, scan angle and channel.
+    #[allow(clippy::too_many_arguments)]
+    pub fn push(&mut self, x: f64, y: f64, z: f64, t: f64, intensity: u16, sa: f32, ch: u8) {
         self.x.push(x);
         self.y.push(y);
         self.z.push(z);
         self.t.push(t);
         self.intensity.push(intensity);
         self.scan_angle_deg.push(sa);
+        self.channel.push(ch);
+    }
+
+    /// Appends point `i` of `o`.
+    pub fn push_from(&mut self, o: &PointColumns, i: usize) {
+        self.push(
+            o.x[i],
+            o.y[i],
+            o.z[i],
+            o.t[i],
+            o.intensity[i],
+            o.scan_angle_deg[i],
+            o.channel[i],
+        );
+    }
+
+    /// Appends the points `range` of `o`.
+    pub fn extend_from(&mut self, o: &PointColumns, range: std::ops::Range<usize>) {
+        self.x.extend_from_slice(&o.x[range.clone()]);
+        self.y.extend_from_slice(&o.y[range.clone()]);
+        self.z.extend_from_slice(&o.z[range.clone()]);
+        self.t.extend_from_slice(&o.t[range.clone()]);
+        self.intensity
+            .extend_from_slice(&o.intensity[range.clone()]);
+        self.scan_angle_deg
+            .extend_from_slice(&o.scan_angle_deg[range.clone()]);
+        self.channel.extend_from_slice(&o.channel[range]);
+    }
+
+    /// Removes the first `n` points.
+    pub fn drain_front(&mut self, n: usize) {
+        self.keep_range(n.min(self.len())..self.len());
+    }
+
+    /// True when the times never decrease.
+    pub fn is_time_ordered(&self) -> bool {
+        self.t.windows(2).all(|w| w[0] <= w[1])
     }
 
     /// Whether the scan angle column carries information (not all one value).
@@ -87,6 +130,7 @@ impl PointColumns {
         go(&mut self.t, &range);
         go(&mut self.intensity, &range);
         go(&mut self.scan_angle_deg, &range);
+        go(&mut self.channel, &range);
     }
 }
 
@@ -112,6 +156,7 @@ pub(super) fn decode_all_parallel(
     cols.t.resize(base + n, 0.0);
     cols.intensity.resize(base + n, 0);
     cols.scan_angle_deg.resize(base + n, 0.0);
+    cols.channel.resize(base + n, 0);
     let mut bad_t = None;
     let PointColumns {
         x,
@@ -120,6 +165,7 @@ pub(super) fn decode_all_parallel(
         t,
         intensity,
         scan_angle_deg,
+        channel,
     } = cols;
     rayon::scope(|s| {
         s.spawn(|_| {
@@ -147,6 +193,11 @@ pub(super) fn decode_all_parallel(
                 } else {
                     f32::from(r[16] as i8)
                 };
+            }
+            if extended {
+                for (v, r) in channel[base..].iter_mut().zip(recs()) {
+                    *v = super::scanner::channel_of(r);
+                }
             }
         });
         let bad = &mut bad_t;

@@ -106,7 +106,8 @@ pub(super) fn decode_points(
                         t,
                     });
                 }
-                cols.push(x, y, z, t, i, sa);
+                let ch = if extended { channel_of(rec) } else { 0 };
+                cols.push(x, y, z, t, i, sa, ch);
             }
         }
         done += n;

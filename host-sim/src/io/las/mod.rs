@@ -15,7 +15,7 @@
 //!
 //! # Memory
 //!
-//! Columns take 38 B per selected point (see [`PointColumns`]). For uncompressed LAS the
+//! Columns take 39 B per selected point (see [`PointColumns`]). For uncompressed LAS the
 //! header's point count is checked against the file size before anything is allocated, so
 //! the columns are reserved once at their final size. For LAZ the count cannot be checked
 //! that way; the reservation is capped by the compressed size (see [`laz_reserve_cap`]) and

@@ -27,6 +27,7 @@ impl PointColumns {
         gather(&mut self.t, &perm);
         gather(&mut self.intensity, &perm);
         gather(&mut self.scan_angle_deg, &perm);
+        gather(&mut self.channel, &perm);
         true
     }
 }
@@ -39,7 +40,7 @@ mod tests {
     fn sorts_stably_and_says_whether_it_reordered() {
         let mut c = PointColumns::default();
         for (k, t) in [2.0, 1.0, 2.0, 0.5].into_iter().enumerate() {
-            c.push(k as f64, 0.0, 0.0, t, k as u16, 0.0);
+            c.push(k as f64, 0.0, 0.0, t, k as u16, 0.0, 0);
         }
         assert!(c.sort_by_time());
         assert_eq!(c.t, vec![0.5, 1.0, 2.0, 2.0]);
