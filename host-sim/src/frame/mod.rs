@@ -5,10 +5,12 @@
 //! 2. [`run`] sends them through `curbtrace_core::Pipeline` via the wire format, with the
 //!    sensor's kernel parameters ([`crate::rings::SensorModel::kernel_params`]).
 //! 3. [`step`] measures the height step across every candidate on the ring's own points
-//!    and rejects vehicles, walls and seams.
+//!    and rejects vehicles, walls and seams; [`column`] rejects candidates on which
+//!    something stands, seen by any ring.
 //! 4. [`link`] links the accepted candidates of each side, ring to ring, into polylines.
 //! 5. [`write`] writes them as GeoJSON or CSV in the sensor frame.
 
+pub mod column;
 pub mod link;
 pub mod run;
 pub mod step;
@@ -118,6 +120,10 @@ pub fn extract_frame(
     pipe: &mut FramePipeline,
 ) -> Result<FrameResult, RunError> {
     let kernel = p.kernel.unwrap_or_else(|| sensor.kernel_params());
+    let step_params = StepParams {
+        min_step_m: p.step.min_step_m.max(step::kernel_floor_m(&kernel)),
+        ..p.step
+    };
     let (arcs, arc_counters) = half_arcs(s, &p.rings);
     let results = run_arcs(s, &arcs, sensor, &kernel, pipe)?;
     let mut out = FrameResult {
@@ -128,6 +134,11 @@ pub fn extract_frame(
         },
         ..FrameResult::default()
     };
+    let grid = column::ColumnGrid::new(
+        s,
+        p.rings.max_reach_m + p.rings.max_lateral_m,
+        p.rings.max_lateral_m + 1.0,
+    );
     let c = &mut out.counters;
     for (arc, r) in arcs.iter().zip(&results) {
         c.points_kernel += u64::from(r.points_out);
@@ -139,11 +150,19 @@ pub fn extract_frame(
                 (Side::Left, Half::Front) | (Side::Right, Half::Rear) => 1,
                 _ => -1,
             };
-            let verdict = step::check(s, &arc.points, k as usize, outward, &p.step);
+            let mut verdict = step::check(s, &arc.points, k as usize, outward, &step_params);
+            if let Verdict::Curb { road_z, .. } = verdict {
+                let i = arc.points[k as usize] as usize;
+                let above = road_z + step_params.max_rise_m;
+                let n = grid.count_above(s, s.x[i], s.y[i], step_params.column_radius_m, above);
+                if n >= step_params.column_min_points {
+                    verdict = Verdict::Column { points: n as u32 };
+                }
+            }
             c.candidates += 1;
             match verdict {
                 Verdict::Curb { .. } => c.curbs += 1,
-                Verdict::Object { .. } => c.objects += 1,
+                Verdict::Object { .. } | Verdict::Column { .. } => c.objects += 1,
                 Verdict::NoStep { .. } => c.no_step += 1,
                 Verdict::Unmeasured => c.unmeasured += 1,
             }

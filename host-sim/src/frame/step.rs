@@ -10,15 +10,16 @@
 //!   candidate (laterally, in y);
 //! - **top** — the median z of the outward points in the same band beyond it;
 //! - **step** = top − road;
-//! - **rise** — the highest point beyond the candidate, above the road: the arc is
-//!   followed outward (across breaks) while it stays within
+//! - **rise** — the highest point beside the candidate, above the road: the arc is
+//!   followed both ways (across breaks) while it stays within
 //!   [`StepParams::object_window_m`] of the candidate laterally, and points within
 //!   [`OBJECT_REACH_M`] of it horizontally count.
 //!
-//! A curb has a step of [`StepParams::min_step_m`]…[`StepParams::max_step_m`] and nothing
-//! beyond its top rises more than [`StepParams::max_rise_m`] above the road within the
-//! window: a vehicle's flank, a wall or a pole rises higher, a road seam or a gutter has no
-//! step.
+//! A curb has a step of [`StepParams::min_step_m`] (at least [`kernel_floor_m`])…
+//! [`StepParams::max_step_m`], and nothing beside it rises more than
+//! [`StepParams::max_rise_m`] above the road within the window (a toe has road on one side
+//! and the kerb top on the other): a vehicle's flank, a wall or a pole rises higher, a road
+//! seam or a gutter has no step.
 
 use crate::io::sweep::Sweep;
 use serde::{Deserialize, Serialize};
@@ -35,17 +36,23 @@ pub struct StepParams {
     pub max_gap_m: f32,
     /// The walk along the ring stops after this path length, metres.
     pub max_walk_m: f32,
-    /// Smallest step of a curb, metres: 3 cm, below the kernel's 4 cm floor of a sharp
-    /// step (d_b · sin τ_min) by the measurement's own noise.
+    /// Smallest step of a curb, metres. The frame job raises it to the kernel's floor
+    /// ([`kernel_floor_m`]): a candidate across a smaller step was not made by a step.
     pub min_step_m: f32,
     /// Largest step of a curb, metres.
     pub max_step_m: f32,
-    /// Window beyond the candidate where nothing may rise above [`Self::max_rise_m`],
-    /// metres.
+    /// Window beside the candidate (both sides) where nothing may rise above
+    /// [`Self::max_rise_m`], metres.
     pub object_window_m: f32,
     /// Highest rise above the road within the window of a curb, metres: the tallest
     /// kerbs are about 0.3 m.
     pub max_rise_m: f32,
+    /// Radius of the column around the candidate in which the points of every ring are
+    /// counted (`frame::column`), metres.
+    pub column_radius_m: f32,
+    /// Points of the column standing more than [`Self::max_rise_m`] above the road that
+    /// make the candidate a vehicle, wall or post (one or two may be a stray return).
+    pub column_min_points: usize,
 }
 
 impl Default for StepParams {
@@ -58,6 +65,8 @@ impl Default for StepParams {
             max_step_m: 0.30,
             object_window_m: 0.6,
             max_rise_m: 0.35,
+            column_radius_m: 0.25,
+            column_min_points: 3,
         }
     }
 }
@@ -66,6 +75,12 @@ impl Default for StepParams {
 /// vehicle parked at the kerb, not a facade farther out that the ring reaches at the same
 /// lateral offset.
 pub const OBJECT_REACH_M: f32 = 3.0;
+
+/// The smallest sharp step the kernel marks as a peak: d_b · sin τ_min (a step of height h
+/// seen with d_b > h bends by asin(h / d_b)), metres.
+pub fn kernel_floor_m(k: &curbtrace_core::kernel::KernelParams) -> f32 {
+    k.d_b_m * k.tau_min_deg.to_radians().sin()
+}
 
 /// What the check found.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -81,6 +96,12 @@ pub enum Verdict {
     Object {
         /// The rise, metres.
         rise_m: f32,
+    },
+    /// Something stands on the candidate: points of the sweep in the column around it
+    /// more than `max_rise_m` above the road (`frame::column`).
+    Column {
+        /// How many.
+        points: u32,
     },
     /// The step is outside the curb range (a seam, a gutter, a dip, a ledge).
     NoStep {
@@ -105,33 +126,38 @@ pub fn check(s: &Sweep, points: &[u32], k: usize, outward: isize, p: &StepParams
             top.push(s.z[i]);
         }
     });
-    // The rise ignores breaks in the ring: a vehicle's flank or a wall is usually met
-    // across one (the beam jumps from the road to the nearer surface). It follows the arc
-    // until it leaves the lateral window, and takes the points within
-    // `OBJECT_REACH_M` of the candidate horizontally.
-    let mut j = k;
-    while let Some(n) = j.checked_add_signed(outward).filter(|&n| n < points.len()) {
-        let i = points[n] as usize;
-        if (s.y[i] - yc).abs() > p.object_window_m {
-            break;
-        }
-        if (s.x[i] - s.x[c]).hypot(s.y[i] - yc) <= OBJECT_REACH_M {
-            rise = rise.max(s.z[i]);
-        }
-        j = n;
-    }
     walk(s, points, k, -outward, p, |i| {
         let o = (s.y[i] - yc).abs();
         if o >= p.band_m[0] && o <= p.band_m[1] {
             road.push(s.z[i]);
         }
     });
-    let (Some(t), Some(r)) = (median(&mut top), median(&mut road)) else {
+    // The rise ignores breaks in the ring: a vehicle's flank or a wall is usually met
+    // across one (the beam jumps from the road to the nearer surface). It follows the arc
+    // both ways until it leaves the lateral window, and takes the points within
+    // `OBJECT_REACH_M` of the candidate horizontally.
+    for dir in [outward, -outward] {
+        let mut j = k;
+        while let Some(n) = j.checked_add_signed(dir).filter(|&n| n < points.len()) {
+            let i = points[n] as usize;
+            if (s.y[i] - yc).abs() > p.object_window_m {
+                break;
+            }
+            if (s.x[i] - s.x[c]).hypot(s.y[i] - yc) <= OBJECT_REACH_M {
+                rise = rise.max(s.z[i]);
+            }
+            j = n;
+        }
+    }
+    let Some(r) = median(&mut road) else {
         return Verdict::Unmeasured;
     };
     if rise - r > p.max_rise_m {
         return Verdict::Object { rise_m: rise - r };
     }
+    let Some(t) = median(&mut top) else {
+        return Verdict::Unmeasured;
+    };
     let step = t - r;
     if step < p.min_step_m || step > p.max_step_m {
         return Verdict::NoStep { step_m: step };

@@ -149,7 +149,7 @@ mod tests {
         assert!(e.starts_with("e.bin: empty file"), "{e}");
         // Points in random azimuth order (not stored laser by laser).
         let mut b = Vec::new();
-        for k in 0..200u32 {
+        for k in 0..2000u32 {
             let a = ((k * 97) % 360) as f32;
             b.extend(record([a.to_radians().cos(), a.to_radians().sin(), 0.0, 0.0]));
         }
