@@ -63,7 +63,13 @@ fn median(v: &mut [f64]) -> f64 {
 
 fn run(s: &Sweep) -> FrameResult {
     let mut pipe = Box::new(FramePipeline::new());
-    extract_frame(s, &SensorModel::for_sweep(s), &FrameParams::default(), &mut pipe).unwrap()
+    extract_frame(
+        s,
+        &SensorModel::for_sweep(s),
+        &FrameParams::default(),
+        &mut pipe,
+    )
+    .unwrap()
 }
 
 /// KITTI frames are stored laser by laser, each laser from ahead round to ahead: the
@@ -73,7 +79,10 @@ fn run(s: &Sweep) -> FrameResult {
 /// while inside a ring, where θ passes 180° behind the car, it runs on (0.1–1.1 %).
 #[test]
 fn kitti_rings_are_recovered_from_the_stored_order() {
-    let Some(dir) = data("kitti_lrbd", "kitti_rings_are_recovered_from_the_stored_order") else {
+    let Some(dir) = data(
+        "kitti_lrbd",
+        "kitti_rings_are_recovered_from_the_stored_order",
+    ) else {
         return;
     };
     for f in KITTI {
@@ -131,7 +140,12 @@ fn nuscenes_sweep_reads_with_its_rings_and_axes() {
             .collect();
         median(&mut v)
     };
-    assert!(elev(0) < -25.0 && elev(31) > 5.0, "{} {}", elev(0), elev(31));
+    assert!(
+        elev(0) < -25.0 && elev(31) > 5.0,
+        "{} {}",
+        elev(0),
+        elev(31)
+    );
     let body: Vec<usize> = (0..s.len())
         .filter(|&i| s.x[i].hypot(s.y[i]) < 2.5 && s.x[i].hypot(s.y[i]) > 0.6)
         .collect();
@@ -143,7 +157,10 @@ fn nuscenes_sweep_reads_with_its_rings_and_axes() {
         hi - lo
     };
     let (along, across) = (span(&|i| s.x[i]), span(&|i| s.y[i]));
-    assert!(along > across, "car body {along} m along x, {across} m across");
+    assert!(
+        along > across,
+        "car body {along} m along x, {across} m across"
+    );
 }
 
 /// Whether a vertex sits on a vehicle or a wall: of the points of the whole sweep within
@@ -173,8 +190,14 @@ fn on_object(s: &Sweep, p: &[f64; 3]) -> bool {
 const SEEN: [(&str, &[(Side, [f64; 2])]); 4] = [
     ("0000000280.bin", &[(Side::Left, [5.5, 6.3])]),
     ("0000000428.bin", &[(Side::Left, [5.8, 6.6])]),
-    ("0000000917.bin", &[(Side::Left, [3.3, 4.1]), (Side::Right, [-3.2, -2.1])]),
-    ("0000000918.bin", &[(Side::Left, [3.3, 4.1]), (Side::Right, [-3.2, -2.1])]),
+    (
+        "0000000917.bin",
+        &[(Side::Left, [3.3, 4.1]), (Side::Right, [-3.2, -2.1])],
+    ),
+    (
+        "0000000918.bin",
+        &[(Side::Left, [3.3, 4.1]), (Side::Right, [-3.2, -2.1])],
+    ),
 ];
 
 /// On the KITTI frames: every polyline's height step is 5–30 cm, no vertex lies on a
@@ -182,7 +205,10 @@ const SEEN: [(&str, &[(Side, [f64; 2])]); 4] = [
 /// least 3 vertices within 10 m of the car, all in the edge's band.
 #[test]
 fn kitti_curbs_are_found_with_curb_heights_and_not_on_objects() {
-    let Some(dir) = data("kitti_lrbd", "kitti_curbs_are_found_with_curb_heights_and_not_on_objects") else {
+    let Some(dir) = data(
+        "kitti_lrbd",
+        "kitti_curbs_are_found_with_curb_heights_and_not_on_objects",
+    ) else {
         return;
     };
     for (f, seen) in SEEN {
@@ -268,8 +294,13 @@ fn timing_per_frame() {
                 read_kitti(&path).unwrap()
             };
             let t1 = t0.elapsed().as_secs_f64();
-            let r = extract_frame(&s, &SensorModel::for_sweep(&s), &FrameParams::default(), &mut pipe)
-                .unwrap();
+            let r = extract_frame(
+                &s,
+                &SensorModel::for_sweep(&s),
+                &FrameParams::default(),
+                &mut pipe,
+            )
+            .unwrap();
             let t2 = t0.elapsed().as_secs_f64();
             best = [best[0].min(t1), best[1].min(t2 - t1), best[2].min(t2)];
             pts = (s.len(), r.counters.points_kernel);
@@ -294,13 +325,13 @@ mod pictures {
 
     static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
-    /// Draws one frame: points coloured by height (viridis, 2 m below the sensor to the
-    /// sensor's height), the checked candidates (white: curb, red: vehicle or wall, grey:
+    /// Draws one frame: points coloured by height (viridis in 25 cm steps, from 2 m below
+    /// the sensor to the sensor's height), the checked candidates (white: curb, red: vehicle or wall, grey:
     /// no curb step or unmeasured), the curb polylines (magenta left, cyan right), a 5 m
     /// grid; x ahead points up the picture, y left to the left.
     pub fn draw(s: &Sweep, r: &FrameResult, title: &str, out: &Path) {
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
-        let root = BitMapBackend::new(out, (760, 900)).into_drawing_area();
+        let root = BitMapBackend::new(out, (600, 720)).into_drawing_area();
         root.fill(&WHITE).unwrap();
         let (xr, yr) = (-22.0f64..30.0f64, -16.0f64..16.0f64);
         let mut chart = ChartBuilder::on(&root)
@@ -323,7 +354,8 @@ mod pictures {
         let pts = (0..s.len())
             .filter(|&i| xr.contains(&f64::from(s.x[i])) && yr.contains(&f64::from(s.y[i])))
             .map(|i| {
-                let t = (f64::from(s.z[i]) + 2.0) / 2.0;
+                // Eight colour steps (25 cm each) keep the PNG small.
+                let t = ((f64::from(s.z[i]) + 2.0) * 4.0).floor() / 8.0;
                 Pixel::new(
                     (f64::from(s.y[i]), f64::from(s.x[i])),
                     curbtrace_host_sim::plot::viridis(t).filled(),
@@ -377,11 +409,21 @@ fn frame_pictures() {
         let s = read_kitti(&dir.join("kitti_lrbd").join(f)).unwrap();
         let r = run(&s);
         let name = f.trim_end_matches(".bin");
-        pictures::draw(&s, &r, &format!("KITTI {name} (HDL-64E)"), &img.join(format!("frame_kitti_{name}.png")));
+        pictures::draw(
+            &s,
+            &r,
+            &format!("KITTI {name} (HDL-64E)"),
+            &img.join(format!("frame_kitti_{name}.png")),
+        );
     }
     let s = read_nuscenes(&dir.join("mmdet3d").join(NUSCENES)).unwrap();
     let r = run(&s);
-    pictures::draw(&s, &r, "nuScenes LIDAR_TOP 1532402927647951 (HDL-32E)", &img.join("frame_nuscenes.png"));
+    pictures::draw(
+        &s,
+        &r,
+        "nuScenes LIDAR_TOP 1532402927647951 (HDL-32E)",
+        &img.join("frame_nuscenes.png"),
+    );
 }
 
 /// A synthetic KITTI frame (48 lasers from −24° to −6°, 0.18° apart, a 12 cm kerb 5.5 m to
@@ -426,9 +468,13 @@ fn frame_command_writes_local_geojson_and_csv() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(err.contains("KITTI (HDL-64E)"), "{err}");
-    let g: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    let g: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
     assert!(g.get("crs").is_none());
-    assert!(g["properties"]["coordinates"].as_str().unwrap().contains("no CRS"));
+    assert!(g["properties"]["coordinates"]
+        .as_str()
+        .unwrap()
+        .contains("no CRS"));
     let f = g["features"].as_array().unwrap();
     assert!(!f.is_empty());
     for feat in f {
@@ -453,7 +499,10 @@ fn frame_command_writes_local_geojson_and_csv() {
     std::fs::write(&bad, [0u8; 30]).unwrap();
     let odd = dir.path().join("scan.xyz");
     std::fs::write(&odd, "1 2 3\n").unwrap();
-    for (p, what) in [(&bad, "not a multiple of 16"), (&odd, "cannot tell the format")] {
+    for (p, what) in [
+        (&bad, "not a multiple of 16"),
+        (&odd, "cannot tell the format"),
+    ] {
         let o = std::process::Command::new(exe)
             .args(["frame", p.to_str().unwrap()])
             .output()
@@ -461,6 +510,9 @@ fn frame_command_writes_local_geojson_and_csv() {
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(1), "{err}");
         assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-        assert!(err.contains(p.to_str().unwrap()) && err.contains(what), "{err}");
+        assert!(
+            err.contains(p.to_str().unwrap()) && err.contains(what),
+            "{err}"
+        );
     }
 }

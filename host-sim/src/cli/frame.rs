@@ -113,13 +113,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 .lines
                 .iter()
                 .filter(|l| l.side == s)
-                .map(|l| {
-                    format!(
-                        "{:.0} cm over {:.1} m",
-                        100.0 * l.height_m,
-                        l.length_m()
-                    )
-                })
+                .map(|l| format!("{:.0} cm over {:.1} m", 100.0 * l.height_m, l.length_m()))
                 .collect();
             if v.is_empty() {
                 "none".to_string()

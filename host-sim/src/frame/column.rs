@@ -99,7 +99,13 @@ mod tests {
         let mut s = Sweep::with_capacity(SweepFormat::Kitti, 0);
         for k in 0..40 {
             let a = k as f32 * 0.157;
-            s.push(5.0 + 0.2 * a.cos(), 2.0 + 0.2 * a.sin(), -1.0 + 0.05 * k as f32, 0.0, 0);
+            s.push(
+                5.0 + 0.2 * a.cos(),
+                2.0 + 0.2 * a.sin(),
+                -1.0 + 0.05 * k as f32,
+                0.0,
+                0,
+            );
         }
         s.push(5.0, 2.6, 1.0, 0.0, 0); // outside the radius
         s.push(30.0, 2.0, 1.0, 0.0, 0); // outside the grid

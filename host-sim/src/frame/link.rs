@@ -86,7 +86,9 @@ mod tests {
 
     #[test]
     fn a_straight_curb_becomes_one_chain_and_strays_are_dropped() {
-        let mut pts: Vec<[f64; 2]> = (0..10).map(|k| [-8.0 + 2.0 * k as f64, 5.9 + 0.01 * (k % 2) as f64]).collect();
+        let mut pts: Vec<[f64; 2]> = (0..10)
+            .map(|k| [-8.0 + 2.0 * k as f64, 5.9 + 0.01 * (k % 2) as f64])
+            .collect();
         pts.push([3.0, 3.0]); // a stray candidate on the road
         pts.push([30.0, 5.9]); // beyond the gap
         let chains = link(&pts, &LinkParams::default());

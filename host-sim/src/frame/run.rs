@@ -75,7 +75,10 @@ pub fn run_arcs(
         };
         r.points_out += o.tag.len() as u32;
         r.truncated += o.truncated;
-        let at = |k: Option<u16>| k.and_then(|k| o.tag.get(usize::from(k))).map(|t| t & 0xFFFF);
+        let at = |k: Option<u16>| {
+            k.and_then(|k| o.tag.get(usize::from(k)))
+                .map(|t| t & 0xFFFF)
+        };
         r.left = at(o.left);
         r.right = at(o.right);
     };

@@ -170,19 +170,9 @@ pub fn check(s: &Sweep, points: &[u32], k: usize, outward: isize, p: &StepParams
 
 /// Calls `f` with every point (sweep index) met walking from position `k` in direction
 /// `dir` while the ring stays unbroken (module docs).
-fn walk(
-    s: &Sweep,
-    points: &[u32],
-    k: usize,
-    dir: isize,
-    p: &StepParams,
-    mut f: impl FnMut(usize),
-) {
+fn walk(s: &Sweep, points: &[u32], k: usize, dir: isize, p: &StepParams, mut f: impl FnMut(usize)) {
     let (mut j, mut path) = (k, 0.0f32);
-    loop {
-        let Some(next) = j.checked_add_signed(dir).filter(|&n| n < points.len()) else {
-            break;
-        };
+    while let Some(next) = j.checked_add_signed(dir).filter(|&n| n < points.len()) {
         let (a, b) = (points[j] as usize, points[next] as usize);
         let d = ((s.x[a] - s.x[b]).powi(2) + (s.y[a] - s.y[b]).powi(2) + (s.z[a] - s.z[b]).powi(2))
             .sqrt();

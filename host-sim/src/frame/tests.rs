@@ -116,7 +116,11 @@ fn both_kerbs_are_found_on_their_sides_with_their_height() {
             for p in &l.points {
                 assert!((p[1] as f32 - y0).abs() < 0.1, "{side:?} vertex {p:?}");
             }
-            assert!((l.height_m as f32 - KERB).abs() < 0.02, "{side:?} {}", l.height_m);
+            assert!(
+                (l.height_m as f32 - KERB).abs() < 0.02,
+                "{side:?} {}",
+                l.height_m
+            );
         }
     }
 }
@@ -178,12 +182,21 @@ fn a_parked_car_and_a_low_wall_are_not_taken_for_curbs() {
     for c in &r.candidates {
         let i = c.point as usize;
         if c.side == Side::Left && off_kerb(s.y[i]) {
-            assert!(!matches!(c.verdict, Verdict::Curb { .. }), "{:?} at {} {}", c.verdict, s.x[i], s.y[i]);
+            assert!(
+                !matches!(c.verdict, Verdict::Curb { .. }),
+                "{:?} at {} {}",
+                c.verdict,
+                s.x[i],
+                s.y[i]
+            );
         }
     }
     for l in &r.lines {
         for p in &l.points {
-            assert!(!(l.side == Side::Left && off_kerb(p[1] as f32)), "vertex off the kerb: {p:?}");
+            assert!(
+                !(l.side == Side::Left && off_kerb(p[1] as f32)),
+                "vertex off the kerb: {p:?}"
+            );
         }
     }
     // The kerb is still found on the left, ahead of and behind the obstacles.

@@ -35,9 +35,12 @@ pub fn read_kitti(path: &Path) -> Result<Sweep, SweepError> {
 /// Parses the bytes of a KITTI `.bin` frame (`path` only names it in errors).
 pub fn parse_kitti(bytes: &[u8], path: &Path) -> Result<Sweep, SweepError> {
     if bytes.is_empty() {
-        return Err(SweepError::format(path, "empty file: a KITTI frame holds x, y, z, reflectance as float32 records of 16 bytes"));
+        return Err(SweepError::format(
+            path,
+            "empty file: a KITTI frame holds x, y, z, reflectance as float32 records of 16 bytes",
+        ));
     }
-    if bytes.len() % RECORD_LEN != 0 {
+    if !bytes.len().is_multiple_of(RECORD_LEN) {
         return Err(SweepError::format(
             path,
             format!(
@@ -51,7 +54,12 @@ pub fn parse_kitti(bytes: &[u8], path: &Path) -> Result<Sweep, SweepError> {
     let mut ring: u16 = 0;
     let mut last_theta = f32::NEG_INFINITY;
     for rec in bytes.chunks_exact(RECORD_LEN) {
-        let (x, y, z, r) = (f32_at(rec, 0), f32_at(rec, 1), f32_at(rec, 2), f32_at(rec, 3));
+        let (x, y, z, r) = (
+            f32_at(rec, 0),
+            f32_at(rec, 1),
+            f32_at(rec, 2),
+            f32_at(rec, 3),
+        );
         if !(x.is_finite() && y.is_finite() && z.is_finite()) {
             s.dropped_non_finite += 1;
             continue;
@@ -143,19 +151,33 @@ mod tests {
 
     #[test]
     fn bad_files_are_refused_in_one_sentence_naming_the_file() {
-        let e = parse_kitti(&[0u8; 17], Path::new("a/b.bin")).unwrap_err().to_string();
-        assert!(e.starts_with("a/b.bin: size 17 bytes is not a multiple of 16"), "{e}");
-        let e = parse_kitti(&[], Path::new("e.bin")).unwrap_err().to_string();
+        let e = parse_kitti(&[0u8; 17], Path::new("a/b.bin"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("a/b.bin: size 17 bytes is not a multiple of 16"),
+            "{e}"
+        );
+        let e = parse_kitti(&[], Path::new("e.bin"))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("e.bin: empty file"), "{e}");
         // Points in random azimuth order (not stored laser by laser).
         let mut b = Vec::new();
         for k in 0..2000u32 {
             let a = ((k * 97) % 360) as f32;
-            b.extend(record([a.to_radians().cos(), a.to_radians().sin(), 0.0, 0.0]));
+            b.extend(record([
+                a.to_radians().cos(),
+                a.to_radians().sin(),
+                0.0,
+                0.0,
+            ]));
         }
         let e = parse_kitti(&b, Path::new("s.bin")).unwrap_err().to_string();
         assert!(e.contains("not stored laser by laser"), "{e}");
-        let e = read_kitti(Path::new("/nonexistent/f.bin")).unwrap_err().to_string();
+        let e = read_kitti(Path::new("/nonexistent/f.bin"))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("/nonexistent/f.bin: "), "{e}");
     }
 }

@@ -29,8 +29,8 @@ pub fn parse_nuscenes(bytes: &[u8], path: &Path) -> Result<Sweep, SweepError> {
     if bytes.is_empty() {
         return Err(SweepError::format(path, "empty file: a nuScenes sweep holds x, y, z, intensity, ring as float32 records of 20 bytes"));
     }
-    if bytes.len() % RECORD_LEN != 0 {
-        let hint = if bytes.len() % 16 == 0 {
+    if !bytes.len().is_multiple_of(RECORD_LEN) {
+        let hint = if bytes.len().is_multiple_of(16) {
             " (a multiple of 16: a KITTI frame? use --format kitti)"
         } else {
             ""
@@ -83,8 +83,13 @@ mod tests {
 
     #[test]
     fn bad_files_are_refused_in_one_sentence_naming_the_file() {
-        let e = parse_nuscenes(&[0u8; 32], Path::new("k.bin")).unwrap_err().to_string();
-        assert!(e.contains("not a multiple of 20") && e.contains("KITTI"), "{e}");
+        let e = parse_nuscenes(&[0u8; 32], Path::new("k.bin"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("not a multiple of 20") && e.contains("KITTI"),
+            "{e}"
+        );
         let e = parse_nuscenes(&record([1.0, 2.0, 3.0, 4.0, 32.0]), Path::new("r.bin"))
             .unwrap_err()
             .to_string();

@@ -47,7 +47,13 @@ pub fn read_pcd(path: &Path) -> Result<Sweep, SweepError> {
         ));
     };
     let ii = find(&INTENSITY_FIELDS);
-    for (i, name) in [(Some(ix), "x"), (Some(iy), "y"), (Some(iz), "z"), (Some(ir), names[ir]), (ii, "intensity")] {
+    for (i, name) in [
+        (Some(ix), "x"),
+        (Some(iy), "y"),
+        (Some(iz), "z"),
+        (Some(ir), names[ir]),
+        (ii, "intensity"),
+    ] {
         if let Some(k) = i.filter(|&k| meta.field_defs.fields[k].count != 1) {
             return Err(SweepError::format(
                 path,
@@ -60,17 +66,22 @@ pub fn read_pcd(path: &Path) -> Result<Sweep, SweepError> {
     }
     let mut s = Sweep::with_capacity(SweepFormat::Pcd, meta.num_points as usize);
     for (i, rec) in reader.enumerate() {
-        let rec: DynRecord = rec.map_err(|e| {
-            SweepError::format(path, format!("point {i} could not be read: {e}"))
-        })?;
+        let rec: DynRecord =
+            rec.map_err(|e| SweepError::format(path, format!("point {i} could not be read: {e}")))?;
         let v = |k: usize| rec.0.get(k).and_then(scalar);
         let (Some(x), Some(y), Some(z), Some(r)) = (v(ix), v(iy), v(iz), v(ir)) else {
-            return Err(SweepError::format(path, format!("point {i} has fewer fields than the header")));
+            return Err(SweepError::format(
+                path,
+                format!("point {i} has fewer fields than the header"),
+            ));
         };
         if !(r >= 0.0 && r < f64::from(u16::MAX) && r.fract() == 0.0) {
             return Err(SweepError::format(
                 path,
-                format!("point {i} has {} {r}, not a whole number in 0..65535", names[ir]),
+                format!(
+                    "point {i} has {} {r}, not a whole number in 0..65535",
+                    names[ir]
+                ),
             ));
         }
         let intensity = ii.and_then(v).unwrap_or(0.0);
@@ -147,9 +158,13 @@ mod tests {
     fn ascii_binary_and_compressed_read_the_same() {
         let dir = tempfile::tempdir().unwrap();
         let mut sweeps = Vec::new();
-        for (k, kind) in [DataKind::Ascii, DataKind::Binary, DataKind::BinaryCompressed]
-            .into_iter()
-            .enumerate()
+        for (k, kind) in [
+            DataKind::Ascii,
+            DataKind::Binary,
+            DataKind::BinaryCompressed,
+        ]
+        .into_iter()
+        .enumerate()
         {
             let p = dir.path().join(format!("f{k}.pcd"));
             write(&p, kind, "ring", 40);
@@ -178,13 +193,21 @@ mod tests {
         let p = dir.path().join("n.pcd");
         write(&p, DataKind::Ascii, "label", 5);
         let e = read_pcd(&p).unwrap_err().to_string();
-        assert!(e.starts_with(&format!("{}: has no ring field", p.display())), "{e}");
+        assert!(
+            e.starts_with(&format!("{}: has no ring field", p.display())),
+            "{e}"
+        );
         assert!(e.contains("x y z intensity label"), "{e}");
         let q = dir.path().join("junk.pcd");
         std::fs::write(&q, b"hello\n").unwrap();
         let e = read_pcd(&q).unwrap_err().to_string();
-        assert!(e.starts_with(&format!("{}: not a readable PCD file", q.display())), "{e}");
-        let e = read_pcd(&dir.path().join("missing.pcd")).unwrap_err().to_string();
+        assert!(
+            e.starts_with(&format!("{}: not a readable PCD file", q.display())),
+            "{e}"
+        );
+        let e = read_pcd(&dir.path().join("missing.pcd"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("missing.pcd: "), "{e}");
         // A ring that is not a whole number.
         let r = dir.path().join("r.pcd");
