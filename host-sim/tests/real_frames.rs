@@ -181,13 +181,16 @@ fn on_object(s: &Sweep, p: &[f64; 3]) -> bool {
     5 * tall > near
 }
 
+/// A road edge seen in a picture: its side and lateral band, metres.
+type Edge = (Side, [f64; 2]);
+
 /// The road edges the pictures in docs/img/ show within 10 m ahead or behind the car, per
 /// frame: (side, lateral band in metres), read off the pictures' point clouds (where the
 /// dense road pattern ends). Frames 280 and 428: a kerb about 6 m to the left, a sidewalk
 /// and a building beyond; on the right a line of points about 4.5 m out without a clear
 /// step (not asserted either way). Frames 917 and 918: a narrow road in a bend, edged on
 /// both sides, vegetation beyond.
-const SEEN: [(&str, &[(Side, [f64; 2])]); 4] = [
+const SEEN: [(&str, &[Edge]); 4] = [
     ("0000000280.bin", &[(Side::Left, [5.5, 6.3])]),
     ("0000000428.bin", &[(Side::Left, [5.8, 6.6])]),
     (

@@ -30,7 +30,7 @@ fn cast(phi: f32, el: f32, car: bool) -> Option<(f32, f32)> {
     let d_top = (H - KERB) / t;
     let beyond = |d: f32| {
         let y = d * s;
-        y > LEFT || y < RIGHT
+        !(RIGHT..=LEFT).contains(&y)
     };
     if beyond(d_top) {
         take(d_top, -(H - KERB));
