@@ -11,8 +11,10 @@
 //! | module | what |
 //! |---|---|
 //! | [`model`] | shared types: sides, categories, polylines, edges; reading GeoJSON lines |
-//! | `io` | LAS/LAZ reading (columns), trajectory CSV |
+//! | `io` | LAS/LAZ reading (columns), trajectory CSV, lidar frames (KITTI, nuScenes, PCD) |
 //! | `replay` | projection (step a), wire encoding, running the core in-process; candidates and per-point status |
+//! | `rings` | spinning lidars: rings cut into half-arcs as scanlines, per-sensor kernel defaults |
+//! | `frame` | curbs in one lidar frame: half-arcs through the core, step check, linking, output |
 //! | `bend` | seeding (§2.6), tracking (§2.7), post-filters |
 //! | `output` | sinks: GeoJSON and CSV writers of the edges |
 //! | `proc_stats` | CPU time and peak memory of this process, from `/proc` |
@@ -24,6 +26,7 @@
 pub mod bend;
 pub mod config;
 pub mod eval;
+pub mod frame;
 pub mod io;
 pub mod model;
 pub mod output;
@@ -32,6 +35,7 @@ pub mod plot;
 pub mod proc_stats;
 pub mod qiu;
 pub mod replay;
+pub mod rings;
 pub mod simulate;
 pub mod source;
 pub mod stream;

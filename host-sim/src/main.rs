@@ -23,6 +23,8 @@ enum Command {
     Demo(cli::demo::Args),
     /// Extracts road edges from a LAS/LAZ file and its trajectory (the main job).
     Extract(cli::extract::Args),
+    /// Curb polylines per lidar frame (KITTI, nuScenes, PCD with rings), in the sensor frame.
+    Frame(cli::frame::Args),
     /// Simulates a mobile laser scanning scene: points.laz, trajectory.csv, reference.geojson.
     Simulate(cli::simulate::Args),
     /// Scores extracted edges against reference lines (Heipke et al. 1997, docs/spec.md §5).
@@ -38,6 +40,7 @@ fn main() {
     let result = match cli.command {
         Command::Demo(a) => cli::demo::run(a),
         Command::Extract(a) => cli::extract::run(a),
+        Command::Frame(a) => cli::frame::run(a),
         Command::Simulate(a) => cli::simulate::run(a),
         Command::Eval(a) => cli::eval::run(a),
         Command::Replay(a) => cli::replay::run(a),
