@@ -213,13 +213,7 @@ impl LasBatches {
                     t,
                 });
             }
-            out.x.push(x);
-            out.y.push(y);
-            out.z.push(z);
-            out.t.push(t);
-            out.intensity.push(i);
-            out.scan_angle_deg.push(sa);
-            out.channel.push(ch);
+            out.push(x, y, z, t, i, sa, ch);
         }
         Ok(())
     }
