@@ -497,6 +497,34 @@ fn frame_command_writes_local_geojson_and_csv() {
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(text.starts_with("frame,line,side,height_m,vertex,x,y,z\n"));
     assert!(text.lines().count() > 3);
+    // The printed defaults read back and give the same polylines.
+    let o = std::process::Command::new(exe)
+        .args(["frame", "--print-config"])
+        .output()
+        .unwrap();
+    let toml_text = String::from_utf8(o.stdout).unwrap();
+    assert!(
+        toml_text.contains("min_separation_m = 0.01\n"),
+        "{toml_text}"
+    );
+    let cfg = dir.path().join("f.toml");
+    std::fs::write(&cfg, &toml_text).unwrap();
+    let again = dir.path().join("d.geojson");
+    let o = std::process::Command::new(exe)
+        .args([
+            "frame",
+            bin.to_str().unwrap(),
+            "--config",
+            cfg.to_str().unwrap(),
+        ])
+        .args(["-o", again.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    assert_eq!(
+        std::fs::read_to_string(&again).unwrap(),
+        std::fs::read_to_string(&out).unwrap()
+    );
     // A truncated file and an unknown extension: one line naming the file, exit 1.
     let bad = dir.path().join("bad.bin");
     std::fs::write(&bad, [0u8; 30]).unwrap();

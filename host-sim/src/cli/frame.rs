@@ -79,7 +79,9 @@ pub fn read(path: &Path, format: Format) -> Result<Sweep, SweepError> {
 /// Runs `curbtrace frame`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     if args.print_config {
-        print!("{}", toml::to_string(&FrameParams::default())?);
+        let mut v = toml::Value::try_from(FrameParams::default())?;
+        shortest_f32(&mut v);
+        print!("{}", toml::to_string(&v)?);
         return Ok(());
     }
     let params: FrameParams = match &args.config {
@@ -159,5 +161,20 @@ fn format_name(f: Format) -> &'static str {
         Format::Kitti => "KITTI",
         Format::Nuscenes => "nuScenes",
         Format::Pcd => "PCD",
+    }
+}
+
+/// Writes every float of `v` (all `f32` parameters) with the fewest digits that read back
+/// to the same `f32` (0.01, not 0.009999999776482582).
+fn shortest_f32(v: &mut toml::Value) {
+    match v {
+        toml::Value::Float(f) => {
+            if let Ok(g) = format!("{}", *f as f32).parse::<f64>() {
+                *f = g;
+            }
+        }
+        toml::Value::Table(t) => t.iter_mut().for_each(|(_, x)| shortest_f32(x)),
+        toml::Value::Array(a) => a.iter_mut().for_each(shortest_f32),
+        _ => {}
     }
 }

@@ -24,8 +24,10 @@ pub struct ColumnGrid {
 }
 
 impl ColumnGrid {
-    /// Bins the points of `s` with |x| ≤ `half_x` and |y| ≤ `half_y` metres.
-    pub fn new(s: &Sweep, half_x: f32, half_y: f32) -> Self {
+    /// Bins the points of `s` with |x| ≤ `half_x`, |y| ≤ `half_y` metres and z above
+    /// `z_min` (the lowest height any column test will ask about: the road's points need
+    /// not be binned).
+    pub fn new(s: &Sweep, half_x: f32, half_y: f32, z_min: f32) -> Self {
         let nx = ((2.0 * half_x / CELL_M).ceil() as usize).max(1);
         let ny = ((2.0 * half_y / CELL_M).ceil() as usize).max(1);
         let mut g = Self {
@@ -36,8 +38,11 @@ impl ColumnGrid {
             start: vec![0; nx * ny + 1],
             idx: Vec::new(),
         };
-        let cells: Vec<Option<usize>> = (0..s.len()).map(|i| g.cell(s.x[i], s.y[i])).collect();
-        for c in cells.iter().flatten() {
+        let cells: Vec<(u32, usize)> = (0..s.len())
+            .filter(|&i| s.z[i] > z_min)
+            .filter_map(|i| g.cell(s.x[i], s.y[i]).map(|c| (i as u32, c)))
+            .collect();
+        for &(_, c) in &cells {
             g.start[c + 1] += 1;
         }
         for c in 0..nx * ny {
@@ -45,11 +50,9 @@ impl ColumnGrid {
         }
         let mut fill = g.start.clone();
         g.idx = vec![0; g.start[nx * ny] as usize];
-        for (i, c) in cells.iter().enumerate() {
-            if let Some(c) = *c {
-                g.idx[fill[c] as usize] = i as u32;
-                fill[c] += 1;
-            }
+        for &(i, c) in &cells {
+            g.idx[fill[c] as usize] = i;
+            fill[c] += 1;
         }
         g
     }
@@ -64,7 +67,7 @@ impl ColumnGrid {
     }
 
     /// Points of `s` within `radius` (≤ [`CELL_M`]) of (x, y) horizontally and above
-    /// `z_above`.
+    /// `z_above` (≥ the grid's `z_min`).
     pub fn count_above(&self, s: &Sweep, x: f32, y: f32, radius: f32, z_above: f32) -> usize {
         let (cx, cy) = ((x - self.x0) / CELL_M, (y - self.y0) / CELL_M);
         if cx < 0.0 || cy < 0.0 {
@@ -109,7 +112,9 @@ mod tests {
         }
         s.push(5.0, 2.6, 1.0, 0.0, 0); // outside the radius
         s.push(30.0, 2.0, 1.0, 0.0, 0); // outside the grid
-        let g = ColumnGrid::new(&s, 20.0, 10.0);
+        let g = ColumnGrid::new(&s, 20.0, 10.0, -0.52);
+        // Points at or below z_min are not binned: k = 10..39 are.
+        assert_eq!(g.count_above(&s, 5.0, 2.0, 0.25, -5.0), 30);
         // z from −1.0 to 0.95 in steps of 0.05: 19 points above 0.01.
         assert_eq!(g.count_above(&s, 5.0, 2.0, 0.25, 0.01), 19);
         assert_eq!(g.count_above(&s, 5.0, 2.0, 0.1, 0.01), 0);

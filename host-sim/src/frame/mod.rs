@@ -134,11 +134,6 @@ pub fn extract_frame(
         },
         ..FrameResult::default()
     };
-    let grid = column::ColumnGrid::new(
-        s,
-        p.rings.max_reach_m + p.rings.max_lateral_m,
-        p.rings.max_lateral_m + 1.0,
-    );
     let c = &mut out.counters;
     for (arc, r) in arcs.iter().zip(&results) {
         c.points_kernel += u64::from(r.points_out);
@@ -150,22 +145,7 @@ pub fn extract_frame(
                 (Side::Left, Half::Front) | (Side::Right, Half::Rear) => 1,
                 _ => -1,
             };
-            let mut verdict = step::check(s, &arc.points, k as usize, outward, &step_params);
-            if let Verdict::Curb { road_z, .. } = verdict {
-                let i = arc.points[k as usize] as usize;
-                let above = road_z + step_params.max_rise_m;
-                let n = grid.count_above(s, s.x[i], s.y[i], step_params.column_radius_m, above);
-                if n >= step_params.column_min_points {
-                    verdict = Verdict::Column { points: n as u32 };
-                }
-            }
-            c.candidates += 1;
-            match verdict {
-                Verdict::Curb { .. } => c.curbs += 1,
-                Verdict::Object { .. } | Verdict::Column { .. } => c.objects += 1,
-                Verdict::NoStep { .. } => c.no_step += 1,
-                Verdict::Unmeasured => c.unmeasured += 1,
-            }
+            let verdict = step::check(s, &arc.points, k as usize, outward, &step_params);
             out.candidates.push(CheckedCandidate {
                 point: arc.points[k as usize],
                 side,
@@ -173,6 +153,43 @@ pub fn extract_frame(
                 half: arc.half,
                 verdict,
             });
+        }
+    }
+    // The column test on the ring's curbs, over a grid of the points that can count.
+    let z_min = out
+        .candidates
+        .iter()
+        .filter_map(|c| match c.verdict {
+            Verdict::Curb { road_z, .. } => Some(road_z + step_params.max_rise_m),
+            _ => None,
+        })
+        .fold(f32::INFINITY, f32::min);
+    if z_min.is_finite() {
+        let grid = column::ColumnGrid::new(
+            s,
+            p.rings.max_reach_m + p.rings.max_lateral_m,
+            p.rings.max_lateral_m + 1.0,
+            z_min,
+        );
+        for cand in out.candidates.iter_mut() {
+            if let Verdict::Curb { road_z, .. } = cand.verdict {
+                let i = cand.point as usize;
+                let above = road_z + step_params.max_rise_m;
+                let n = grid.count_above(s, s.x[i], s.y[i], step_params.column_radius_m, above);
+                if n >= step_params.column_min_points {
+                    cand.verdict = Verdict::Column { points: n as u32 };
+                }
+            }
+        }
+    }
+    let c = &mut out.counters;
+    for cand in &out.candidates {
+        c.candidates += 1;
+        match cand.verdict {
+            Verdict::Curb { .. } => c.curbs += 1,
+            Verdict::Object { .. } | Verdict::Column { .. } => c.objects += 1,
+            Verdict::NoStep { .. } => c.no_step += 1,
+            Verdict::Unmeasured => c.unmeasured += 1,
         }
     }
     for side in [Side::Left, Side::Right] {
