@@ -204,23 +204,6 @@ fn trajectory_times_going_backwards() {
 
 mod common;
 
-/// Runs `curbtrace extract` and returns (success, stderr).
-fn extract(points: &Path, traj: &Path, out: &Path) -> (bool, String) {
-    let run = std::process::Command::new(env!("CARGO_BIN_EXE_curbtrace"))
-        .arg("extract")
-        .arg(points)
-        .arg("--trajectory")
-        .arg(traj)
-        .arg("-o")
-        .arg(out)
-        .output()
-        .unwrap();
-    (
-        run.status.success(),
-        String::from_utf8_lossy(&run.stderr).into_owned(),
-    )
-}
-
 #[test]
 fn cli_bad_inputs_exit_non_zero_with_one_line() {
     let dir = tempfile::tempdir().unwrap();
@@ -248,7 +231,7 @@ fn cli_bad_inputs_exit_non_zero_with_one_line() {
         (&las, &bad_traj, "bad header"),
         (&las, &week, "GPS week seconds"),
     ] {
-        let (ok, err) = extract(p, t, &out);
+        let (ok, err) = common::extract(p, t, &out);
         assert!(!ok, "{err}");
         assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
         assert!(err.contains(want), "{err}");

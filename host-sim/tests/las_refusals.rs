@@ -297,23 +297,6 @@ fn the_reason_for_a_missing_crs_is_kept() {
     }
 }
 
-/// Runs `curbtrace extract` and returns (success, stderr).
-fn extract(points: &Path, traj: &Path, out: &Path) -> (bool, String) {
-    let run = std::process::Command::new(env!("CARGO_BIN_EXE_curbtrace"))
-        .arg("extract")
-        .arg(points)
-        .arg("--trajectory")
-        .arg(traj)
-        .arg("-o")
-        .arg(out)
-        .output()
-        .unwrap();
-    (
-        run.status.success(),
-        String::from_utf8_lossy(&run.stderr).into_owned(),
-    )
-}
-
 #[test]
 fn extract_warns_when_the_output_has_no_crs_and_its_summary_suits_a_small_file() {
     let dir = tempfile::tempdir().unwrap();
@@ -333,7 +316,7 @@ fn extract_warns_when_the_output_has_no_crs_and_its_summary_suits_a_small_file()
             .collect()
     };
     // The road's file has an EPSG code: no warning.
-    let (ok, err) = extract(&las, &traj, &out);
+    let (ok, err) = common::extract(&las, &traj, &out);
     assert!(ok && warnings(&err).is_empty(), "{err}");
     let memory = err.lines().find(|l| l.starts_with("peak memory")).unwrap();
     assert!(
@@ -348,7 +331,7 @@ fn extract_warns_when_the_output_has_no_crs_and_its_summary_suits_a_small_file()
         .unwrap();
     bytes[id..id + 15].copy_from_slice(b"not_a_crs_vlr__");
     std::fs::write(&las, &bytes).unwrap();
-    let (ok, err) = extract(&las, &traj, &out);
+    let (ok, err) = common::extract(&las, &traj, &out);
     let w = warnings(&err);
     assert!(ok && w.len() == 1, "{err}");
     assert!(
@@ -363,7 +346,7 @@ fn extract_warns_when_the_output_has_no_crs_and_its_summary_suits_a_small_file()
         ..Default::default()
     };
     short.write(&las, &traj);
-    let (ok, err) = extract(&las, &traj, &out);
+    let (ok, err) = common::extract(&las, &traj, &out);
     assert!(
         ok && err.contains("edges              0, total length 0.0 m"),
         "{err}"

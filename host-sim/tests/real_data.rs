@@ -32,34 +32,8 @@ use std::process::Command;
 // Where the data are
 // ---------------------------------------------------------------------------------------
 
-/// The `realdata` folder, if present: `$CURBTRACE_REALDATA`, else `shared/realdata` in the
-/// parent of the workspace root or one of its next two ancestors (worktrees may sit one or
-/// two levels deeper than the main checkout).
-fn realdata_dir() -> Option<PathBuf> {
-    if let Some(d) = std::env::var_os("CURBTRACE_REALDATA") {
-        let d = PathBuf::from(d);
-        return d.is_dir().then_some(d);
-    }
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent()?;
-    root.ancestors()
-        .skip(1)
-        .take(3)
-        .map(|a| a.join("shared/realdata"))
-        .find(|d| d.is_dir())
-}
-
-/// The sub-folder `sub` of the data, or `None` after printing why the test is skipped.
-fn data(sub: &str, test: &str) -> Option<PathBuf> {
-    let found = realdata_dir().map(|d| d.join(sub)).filter(|d| d.is_dir());
-    if found.is_none() {
-        eprintln!(
-            "skipped: {test}: {sub} not found (looked in $CURBTRACE_REALDATA and in \
-             shared/realdata beside {}/.. and its parents)",
-            env!("CARGO_MANIFEST_DIR")
-        );
-    }
-    found
-}
+mod common;
+use common::data;
 
 const AMS: &str = "amsterdam_cyclomedia";
 

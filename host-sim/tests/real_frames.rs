@@ -22,31 +22,8 @@ use curbtrace_host_sim::model::Side;
 use curbtrace_host_sim::rings::SensorModel;
 use std::path::{Path, PathBuf};
 
-/// The `realdata` folder, if present (see the module docs).
-fn realdata_dir() -> Option<PathBuf> {
-    if let Some(d) = std::env::var_os("CURBTRACE_REALDATA") {
-        let d = PathBuf::from(d);
-        return d.is_dir().then_some(d);
-    }
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent()?;
-    root.ancestors()
-        .skip(1)
-        .take(3)
-        .map(|a| a.join("shared/realdata"))
-        .find(|d| d.is_dir())
-}
-
-/// The sub-folder `sub` of the data, or `None` after printing why the test is skipped.
-fn data(sub: &str, test: &str) -> Option<PathBuf> {
-    let found = realdata_dir().map(|d| d.join(sub)).filter(|d| d.is_dir());
-    if found.is_none() {
-        eprintln!(
-            "skipped: {test}: {sub} not found (looked in $CURBTRACE_REALDATA and in shared/realdata beside {}/.. and its parents)",
-            env!("CARGO_MANIFEST_DIR")
-        );
-    }
-    found
-}
+mod common;
+use common::{data, realdata_dir};
 
 const KITTI: [&str; 4] = [
     "0000000280.bin",

@@ -6,7 +6,7 @@ use las::{Builder, Point, Writer};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// World origin of the scenes (a projected CRS, large coordinates as in real data).
 pub const X0: f64 = 500_000.0;
@@ -170,4 +170,50 @@ impl Road {
     pub fn toe_x(&self) -> (f64, f64) {
         (X0 - self.half_width_m, X0 + self.half_width_m)
     }
+}
+
+/// Runs `curbtrace extract` and returns (success, stderr).
+pub fn extract(points: &Path, traj: &Path, out: &Path) -> (bool, String) {
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_curbtrace"))
+        .arg("extract")
+        .arg(points)
+        .arg("--trajectory")
+        .arg(traj)
+        .arg("-o")
+        .arg(out)
+        .output()
+        .unwrap();
+    (
+        run.status.success(),
+        String::from_utf8_lossy(&run.stderr).into_owned(),
+    )
+}
+
+/// The `realdata` folder, if present: `$CURBTRACE_REALDATA`, else `shared/realdata` in the
+/// parent of the workspace root or one of its next two ancestors (worktrees may sit one or
+/// two levels deeper than the main checkout).
+pub fn realdata_dir() -> Option<PathBuf> {
+    if let Some(d) = std::env::var_os("CURBTRACE_REALDATA") {
+        let d = PathBuf::from(d);
+        return d.is_dir().then_some(d);
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent()?;
+    root.ancestors()
+        .skip(1)
+        .take(3)
+        .map(|a| a.join("shared/realdata"))
+        .find(|d| d.is_dir())
+}
+
+/// The sub-folder `sub` of the data, or `None` after printing why the test is skipped.
+pub fn data(sub: &str, test: &str) -> Option<PathBuf> {
+    let found = realdata_dir().map(|d| d.join(sub)).filter(|d| d.is_dir());
+    if found.is_none() {
+        eprintln!(
+            "skipped: {test}: {sub} not found (looked in $CURBTRACE_REALDATA and in \
+             shared/realdata beside {}/.. and its parents)",
+            env!("CARGO_MANIFEST_DIR")
+        );
+    }
+    found
 }
