@@ -64,6 +64,29 @@ pub(super) fn nearest(tree: &RTree<Seg>, p: [f64; 2]) -> Option<(usize, f64)> {
         .map(|s| (s.data, s.distance_2(&p).sqrt()))
 }
 
+/// Both line sets in horizontal coordinates relative to their first finite vertex (so the
+/// sums stay exact far from the CRS origin): (origin, reference, extracted).
+pub(super) type LocalPair = ([f64; 2], Vec<Vec<[f64; 2]>>, Vec<Vec<[f64; 2]>>);
+
+/// [`to_local`] for a reference and an extraction about one shared origin.
+pub(super) fn to_local_pair(
+    reference: &[EdgeLine],
+    extracted: &[EdgeLine],
+) -> Result<LocalPair, EvalError> {
+    let origin = reference
+        .iter()
+        .chain(extracted)
+        .find_map(|l| l.points.first())
+        .map(|p| [p[0], p[1]])
+        .filter(|o| o[0].is_finite() && o[1].is_finite())
+        .unwrap_or([0.0, 0.0]);
+    Ok((
+        origin,
+        to_local(reference, origin, "reference")?,
+        to_local(extracted, origin, "extracted")?,
+    ))
+}
+
 pub(super) fn to_local(
     lines: &[EdgeLine],
     origin: [f64; 2],

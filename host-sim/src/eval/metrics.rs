@@ -1,7 +1,7 @@
 //! The metrics: per column (total, side, side and category) sums of matched, TP and FP
 //! lengths, gaps and outside pieces, and [`evaluate`], which fills them.
 
-use super::matching::{nearest, sample_polyline, segment_tree, to_local};
+use super::matching::{nearest, sample_polyline, segment_tree, to_local_pair};
 use super::{check_params, EvalError, EvalParams};
 use crate::model::{Category, EdgeLine, Side};
 use rayon::prelude::*;
@@ -182,15 +182,7 @@ pub fn evaluate(
     params: &EvalParams,
 ) -> Result<EvalReport, EvalError> {
     check_params(params)?;
-    let origin = reference
-        .iter()
-        .chain(extracted)
-        .find_map(|l| l.points.first())
-        .map(|p| [p[0], p[1]])
-        .filter(|o| o[0].is_finite() && o[1].is_finite())
-        .unwrap_or([0.0, 0.0]);
-    let ref_xy = to_local(reference, origin, "reference")?;
-    let ext_xy = to_local(extracted, origin, "extracted")?;
+    let (_, ref_xy, ext_xy) = to_local_pair(reference, extracted)?;
     let ref_tree = segment_tree(&ref_xy);
     let ext_tree = segment_tree(&ext_xy);
     // Lengths are counted in samples per line and multiplied by the line's piece length once,

@@ -3,7 +3,7 @@
 //! extracted line outside the buffer of every reference line (a false edge), whichever is
 //! longer. Runs are measured on the same samples as the metrics.
 
-use super::matching::{nearest, sample_polyline, segment_tree, to_local};
+use super::matching::{nearest, sample_polyline, segment_tree, to_local_pair};
 use super::{check_params, EvalError, EvalParams};
 use crate::model::{Category, EdgeLine, Side};
 
@@ -75,15 +75,7 @@ pub fn worst_place(
     params: &EvalParams,
 ) -> Result<Option<WorstPlace>, EvalError> {
     check_params(params)?;
-    let origin = reference
-        .iter()
-        .chain(extracted)
-        .find_map(|l| l.points.first())
-        .map(|p| [p[0], p[1]])
-        .filter(|o| o[0].is_finite() && o[1].is_finite())
-        .unwrap_or([0.0, 0.0]);
-    let ref_xy = to_local(reference, origin, "reference")?;
-    let ext_xy = to_local(extracted, origin, "extracted")?;
+    let (origin, ref_xy, ext_xy) = to_local_pair(reference, extracted)?;
     let missed = longest_run(&ref_xy, &ext_xy, params);
     let false_edge = longest_run(&ext_xy, &ref_xy, params);
     let (run, kind) = match (missed, false_edge) {
