@@ -34,9 +34,14 @@
 //! assert_eq!(p.counters().kernel_points, 50);
 //! ```
 
-use crate::kernel::{Kernel, KernelParams, ParamsError, PointStatus, ScanlineOutput};
+use crate::kernel::{
+    Kernel, KernelParams, OutputMode, ParamsError, PointStatus, ScanlineOutput,
+};
 use crate::scanline::{Ingest, IngestCounters, IngestEvent};
-use crate::wire::{EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr, StreamEncoder};
+use crate::wire::{
+    CandidatesRepr, EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr,
+    StreamEncoder,
+};
 
 /// Everything the pipeline counted: ingest's counters plus the kernel's, summed over lines,
 /// and the config packets.
@@ -57,6 +62,8 @@ pub struct PipelineCounters {
     pub no_neighbour: u64,
     /// Points with status [`PointStatus::NonFinite`].
     pub non_finite: u64,
+    /// Points with status [`PointStatus::OutsideRoi`] (not processed by the kernel).
+    pub outside_roi: u64,
     /// Peaks found.
     pub peaks: u64,
     /// Lines with a left candidate.
@@ -101,6 +108,7 @@ impl<const RING: usize, const N: usize> Pipeline<RING, N> {
                 irregular: 0,
                 no_neighbour: 0,
                 non_finite: 0,
+                outside_roi: 0,
                 peaks: 0,
                 left_candidates: 0,
                 right_candidates: 0,
@@ -163,6 +171,7 @@ impl<const RING: usize, const N: usize> Pipeline<RING, N> {
                     c.irregular += u64::from(k.irregular);
                     c.no_neighbour += u64::from(k.no_neighbour);
                     c.non_finite += u64::from(k.non_finite);
+                    c.outside_roi += u64::from(k.outside_roi);
                     c.peaks += u64::from(k.peaks);
                     c.left_candidates += u64::from(out.left.is_some());
                     c.right_candidates += u64::from(out.right.is_some());
@@ -198,8 +207,10 @@ impl<const RING: usize, const N: usize> Default for Pipeline<RING, N> {
     }
 }
 
-/// Writes all output packets of one line back to back into `buf` (see
-/// `docs/wire-format.md`); returns the bytes written. `buf` needs
+/// Writes what the line's output mode asks for into `buf` (see `docs/wire-format.md`):
+/// in [`OutputMode::Candidates`] the line's one candidates packet
+/// ([`encode_candidates`]), otherwise all its output packets back to back; returns the
+/// bytes written. `buf` needs
 /// `wire::output_packet_len` of each fragment — at most
 /// ⌈len / `MAX_OUTPUT_POINTS_PER_PACKET`⌉ · `MAX_PACKET_LEN` bytes. The header is
 /// [`output_header`]'s and point `i` is [`output_point`]'s; each packet is
@@ -211,6 +222,9 @@ pub fn encode_output(
     enc: &mut StreamEncoder,
     buf: &mut [u8],
 ) -> Result<usize, EncodeError> {
+    if out.output_mode == OutputMode::Candidates {
+        return encode_candidates(out, enc, buf);
+    }
     let header = output_header(out)?;
     let mut at = 0usize;
     for k in 0..header.fragments() {
@@ -254,6 +268,29 @@ pub fn encode_output_fragment(
     )
 }
 
+/// Writes the line's candidates packet (kind 4, wire version 2): its header as
+/// [`output_header`] gives it and the output records ([`output_point`]) of its nadir and
+/// seed candidates. Returns the packet length.
+pub fn encode_candidates(
+    out: &ScanlineOutput<'_>,
+    enc: &mut StreamEncoder,
+    buf: &mut [u8],
+) -> Result<usize, EncodeError> {
+    enc.encode_candidates(&candidates_repr(out)?, buf)
+}
+
+/// The candidates packet of a line (see [`encode_candidates`]).
+pub fn candidates_repr(out: &ScanlineOutput<'_>) -> Result<CandidatesRepr, EncodeError> {
+    let header = output_header(out)?;
+    let rec = |i: Option<u16>| i.map(|i| output_point(out, usize::from(i))).transpose();
+    Ok(CandidatesRepr {
+        header,
+        nadir: rec(out.nadir)?,
+        left: rec(out.left)?,
+        right: rec(out.right)?,
+    })
+}
+
 /// The wire header of a line's output packets. Counters above 65 535 saturate in the
 /// header's 16-bit fields.
 pub fn output_header(out: &ScanlineOutput<'_>) -> Result<OutputHeaderRepr, EncodeError> {
@@ -276,22 +313,29 @@ pub fn output_header(out: &ScanlineOutput<'_>) -> Result<OutputHeaderRepr, Encod
         irregular: sat(out.counters.irregular),
         no_neighbour: sat(out.counters.no_neighbour),
         peaks: sat(out.counters.peaks),
+        outside: sat(out.counters.outside_roi),
     })
 }
 
 /// Output point `i` of a line. A non-finite point (status [`PointStatus::NonFinite`],
 /// which ingest normally drops before the kernel) is sent at x′ = z′ = 0 with its status,
-/// so the line still encodes.
+/// so the line still encodes; so is a point outside the region of interest
+/// ([`PointStatus::OutsideRoi`]) whose raw coordinates are beyond ±`MAX_COORD_M` (the
+/// kernel would have set it aside as non-finite).
 pub fn output_point(out: &ScanlineOutput<'_>, i: usize) -> Result<OutputPointRepr, EncodeError> {
     let status = *out
         .status
         .get(i)
         .ok_or(EncodeError::OutOfRange { index: i })?;
     let get = |s: &[f32]| s.get(i).copied().unwrap_or(0.0);
-    let (x, z) = if status == PointStatus::NonFinite {
+    let (x, z) = (get(out.x_m), get(out.z_m));
+    let lim = crate::kernel::bend::MAX_COORD_M;
+    let (x, z) = if status == PointStatus::NonFinite
+        || (status == PointStatus::OutsideRoi && !(x.abs() <= lim && z.abs() <= lim))
+    {
         (0.0, 0.0)
     } else {
-        (get(out.x_m), get(out.z_m))
+        (x, z)
     };
     let tag = out.tag.get(i).copied().unwrap_or(0);
     OutputPointRepr::from_f32(tag, x, z, get(out.rho_deg), status as u8, i)

@@ -9,7 +9,7 @@
 //! config packets, kernel) and `pipeline::{output_header, encode_output_fragment}` (the
 //! bytes `encode_output` writes), so `firmware/check.sh` compares the same code on two CPUs.
 
-use curbtrace_core::kernel::{KernelCounters, ScanlineOutput};
+use curbtrace_core::kernel::{KernelCounters, OutputMode, ScanlineOutput};
 use curbtrace_core::pipeline::{self, Pipeline, PipelineCounters};
 use curbtrace_core::wire::{
     EncodeError, StreamEncoder, MAX_OUTPUT_POINTS_PER_PACKET, MAX_PACKET_LEN,
@@ -151,10 +151,12 @@ fn add_counters(total: &mut KernelCounters, c: &KernelCounters) {
     total.peaks += c.peaks;
     total.capped_windows += c.capped_windows;
     total.smooth_pieces += c.smooth_pieces;
+    total.outside_roi += c.outside_roi;
 }
 
 /// Writes one line's output packets, one packet buffer at a time (a whole 2048-point line
-/// would need 34 KiB at once); the bytes are `pipeline::encode_output`'s.
+/// would need 34 KiB at once), or its one candidates packet; the bytes are
+/// `pipeline::encode_output`'s.
 fn emit_line<W: Write, E>(
     out: &ScanlineOutput<'_>,
     enc: &mut StreamEncoder,
@@ -162,6 +164,14 @@ fn emit_line<W: Write, E>(
     output: &mut W,
     sum: &mut Summary,
 ) -> Result<(), Error<E, W::Error>> {
+    if out.output_mode == OutputMode::Candidates {
+        let n = pipeline::encode_candidates(out, enc, packet)
+            .map_err(|e| Error::Encode(out.index, e))?;
+        output.write_all(&packet[..n]).map_err(Error::Write)?;
+        sum.packets_out += 1;
+        sum.bytes_out += n as u64;
+        return Ok(());
+    }
     let header = pipeline::output_header(out).map_err(|e| Error::Encode(out.index, e))?;
     for k in 0..header.fragments() {
         let first = u16::try_from(k * MAX_OUTPUT_POINTS_PER_PACKET)

@@ -145,6 +145,7 @@ fn figures(summary: &Summary, stack_init: usize) {
     figure!("irregular", summary.kernel.irregular);
     figure!("no_neighbour", summary.kernel.no_neighbour);
     figure!("peaks", summary.kernel.peaks);
+    figure!("outside_roi", summary.kernel.outside_roi);
     figure!("packets_out", summary.packets_out);
     figure!("bytes_out", summary.bytes_out);
     figure!("ring_bytes", RING);

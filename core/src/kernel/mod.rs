@@ -18,12 +18,17 @@
 //! 6. The partition is undone by replaying its swaps backwards, so every output slice is
 //!    indexed by input point again; set-aside points get their raw coordinates back.
 //!
+//! With a region of interest ([`KernelParams::roi`]), the points inside it are first moved
+//! to the front the same way (step 0), steps 1–6 run on them alone, and that partition is
+//! undone last; the points outside keep their raw coordinates, ρ = 0 and
+//! [`PointStatus::OutsideRoi`].
+//!
 //! # Memory
 //!
 //! Per point of capacity `N`: the line's x′, z′, tag (12 bytes) plus the kernel's ρ (`f32`),
-//! status (`u8`) and two `u8` of working space (the window's ends as offsets; the right one
-//! later holds the status of a kept point) — 19 bytes — plus a 1 KiB deque for the peak
-//! search and the parameters.
+//! status (`u8`), two `u8` of working space (the window's ends as offsets; the right one
+//! later holds the status of a kept point) and the region-of-interest mark (`bool`) — 20
+//! bytes — plus a 1 KiB deque for the peak search and the parameters.
 //! ρ's buffer doubles as the smoothing scratch before ρ is computed.
 
 use crate::math::{self, Maths};
@@ -40,7 +45,7 @@ mod synth;
 /// The config packet's word count, defined by the wire format and re-exported beside the
 /// parameters that fill it.
 pub use crate::wire::CONFIG_WORDS;
-pub use params::{KernelParams, Param, ParamsError};
+pub use params::{KernelParams, OutputMode, Param, ParamsError, Roi};
 
 /// What happened to one input point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,6 +62,9 @@ pub enum PointStatus {
     /// Removed before anything else: x′ or z′ is NaN, infinite or beyond ±2000 m
     /// (`MAX_COORD_M`).
     NonFinite = 3,
+    /// Outside the region of interest ([`KernelParams::roi`]): not processed, raw
+    /// coordinates, ρ reported as 0. Wire version 2.
+    OutsideRoi = 4,
 }
 
 impl PointStatus {
@@ -67,6 +75,7 @@ impl PointStatus {
             1 => Some(Self::Irregular),
             2 => Some(Self::NoNeighbour),
             3 => Some(Self::NonFinite),
+            4 => Some(Self::OutsideRoi),
             _ => None,
         }
     }
@@ -94,6 +103,8 @@ pub struct KernelCounters {
     pub capped_windows: u32,
     /// Pieces the line was smoothed in (split at gaps, see [`KernelParams::smooth_gap_m`]).
     pub smooth_pieces: u32,
+    /// Points with status [`PointStatus::OutsideRoi`].
+    pub outside_roi: u32,
 }
 
 /// The kernel's result for one scanline, borrowed from the kernel's buffers (no copies).
@@ -126,6 +137,8 @@ pub struct ScanlineOutput<'a> {
     pub truncated: u32,
     /// Counters for this line.
     pub counters: KernelCounters,
+    /// What the parameters in force ask to send for the line.
+    pub output_mode: OutputMode,
 }
 
 /// Values derived from the parameters once, not per line.
@@ -164,6 +177,8 @@ pub struct Kernel<const N: usize> {
     aux: [u8; N],
     /// Per point: i − s(i).
     s_off: [u8; N],
+    /// Per input point: inside the region of interest (written only when one is set).
+    inside: [bool; N],
     /// The peak search's window-maximum deque.
     deque: [u16; seed::DEQUE_LEN],
     /// `params_hash` and `derived` are still to be computed from `params` (a kernel made
@@ -188,6 +203,7 @@ impl<const N: usize> Kernel<N> {
             status: [PointStatus::Kept; N],
             aux: [0; N],
             s_off: [0; N],
+            inside: [false; N],
             deque: [0; seed::DEQUE_LEN],
             fresh: true,
         }
@@ -225,11 +241,22 @@ impl<const N: usize> Kernel<N> {
             self.derived = Derived::new(&self.params);
             self.fresh = false;
         }
-        let n = line.len.min(N);
+        let n_all = line.len.min(N);
         let p = self.params;
         let Derived { d2, irregular } = self.derived;
+        // 0. The points inside the region of interest to the front, in order.
+        let (n, first_roi_out) = match p.roi() {
+            Some(roi) => roi_partition(
+                &mut line.x_m[..n_all],
+                &mut line.z_m[..n_all],
+                &mut self.inside[..n_all],
+                roi,
+            ),
+            None => (n_all, n_all),
+        };
         let mut c = KernelCounters {
-            points_in: n as u32,
+            points_in: n_all as u32,
+            outside_roi: (n_all - n) as u32,
             ..KernelCounters::default()
         };
         let x = &mut line.x_m[..n];
@@ -304,22 +331,38 @@ impl<const N: usize> Kernel<N> {
         } else {
             idx = unpartition(x, z, rho, status, aux, first_out, kept, idx);
         }
+        // 7. The points outside the region of interest back in place.
+        if n < n_all {
+            self.rho[n..n_all].fill(0.0);
+            self.status[n..n_all].fill(PointStatus::OutsideRoi);
+            idx = roi_unpartition(
+                &mut line.x_m[..n_all],
+                &mut line.z_m[..n_all],
+                &mut self.rho[..n_all],
+                &mut self.status[..n_all],
+                &self.inside[..n_all],
+                first_roi_out,
+                n,
+                idx,
+            );
+        }
         let [nadir, left, right] = idx.map(|o| o.map(|i| i as u16));
 
         ScanlineOutput {
             index: line.index,
             start_time_ns: line.start_time_ns,
             params_hash: self.params_hash,
-            tag: &line.tag[..n],
-            x_m: &line.x_m[..n],
-            z_m: &line.z_m[..n],
-            rho_deg: &self.rho[..n],
-            status: &self.status[..n],
+            tag: &line.tag[..n_all],
+            x_m: &line.x_m[..n_all],
+            z_m: &line.z_m[..n_all],
+            rho_deg: &self.rho[..n_all],
+            status: &self.status[..n_all],
             nadir,
             left,
             right,
             truncated: line.truncated,
             counters: c,
+            output_mode: p.output_mode(),
         }
     }
 }
@@ -377,6 +420,76 @@ fn unpartition(
     }
     for (st, &a) in status[..first_out].iter_mut().zip(aux.iter()) {
         *st = status_of(a);
+    }
+    map
+}
+
+/// Step 0 of [`Kernel::process`] with a region of interest: marks every point in
+/// `inside` and moves the points inside to the front, in order (a Lomuto partition from
+/// the first point outside). Returns (points inside, index of the first point outside).
+#[inline(never)]
+fn roi_partition(x: &mut [f32], z: &mut [f32], inside: &mut [bool], roi: Roi) -> (usize, usize) {
+    let n = inside.len();
+    let (x, z) = (&mut x[..n], &mut z[..n]);
+    let mut first_out = n;
+    for i in 0..n {
+        let ins = roi.contains(x[i], z[i]);
+        inside[i] = ins;
+        if !ins {
+            first_out = i;
+            break;
+        }
+    }
+    let mut w = first_out;
+    for i in first_out.saturating_add(1)..n {
+        let (xi, zi) = (x[i], z[i]);
+        let ins = roi.contains(xi, zi);
+        inside[i] = ins;
+        if ins {
+            x[i] = x[w];
+            z[i] = z[w];
+            x[w] = xi;
+            z[w] = zi;
+            w += 1;
+        }
+    }
+    (w, first_out)
+}
+
+/// Step 7 of [`Kernel::process`]: replays [`roi_partition`]'s swaps backwards on the
+/// coordinates, ρ and status (the points outside sit at `inside_count..` with their ρ and
+/// status already set), and maps the indices `idx` (among the points inside) back to input
+/// indices.
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+fn roi_unpartition(
+    x: &mut [f32],
+    z: &mut [f32],
+    rho: &mut [f32],
+    status: &mut [PointStatus],
+    inside: &[bool],
+    first_out: usize,
+    inside_count: usize,
+    idx: [Option<usize>; 3],
+) -> [Option<usize>; 3] {
+    let n = inside.len();
+    let (x, z, rho, status) = (&mut x[..n], &mut z[..n], &mut rho[..n], &mut status[..n]);
+    let want = idx.map(|o| o.unwrap_or(usize::MAX));
+    let mut map = idx;
+    let mut w = inside_count;
+    for i in (first_out..n).rev() {
+        if inside[i] {
+            w -= 1;
+            x.swap(w, i);
+            z.swap(w, i);
+            rho.swap(w, i);
+            status.swap(w, i);
+            for (m, &o) in map.iter_mut().zip(want.iter()) {
+                if o == w {
+                    *m = Some(i);
+                }
+            }
+        }
     }
     map
 }

@@ -15,7 +15,17 @@
 //! | 7 | [`KernelParams::smooth_gap_m`] | f32 bits | [0, 100] |
 //! | 8 | [`KernelParams::split_gap_ns`] | u32 | any |
 //! | 9 | [`KernelParams::split_geometry`] | u32 | 0 = auto, 1 = always, 2 = never |
-//! | 10–15 | reserved | 0 | 0 |
+//! | 10 | [`KernelParams::roi_x_min_m`] | f32 bits | [−2000, 2000]; see below |
+//! | 11 | [`KernelParams::roi_x_max_m`] | f32 bits | (roi_x_min_m, 2000] |
+//! | 12 | [`KernelParams::roi_z_min_m`] | f32 bits | [−2000, 2000] |
+//! | 13 | [`KernelParams::roi_z_max_m`] | f32 bits | (roi_z_min_m, 2000] |
+//! | 14 | [`KernelParams::output_mode`] | u32 | 0 = points, 1 = candidates |
+//! | 15 | reserved | 0 | 0 |
+//!
+//! Words 10–14 are wire-format version 2 (a config packet that sets one is a version-2
+//! packet). The region of interest is off when words 10–13 are all zero; otherwise it is
+//! the box `roi_x_min_m ≤ x′ ≤ roi_x_max_m`, `roi_z_min_m ≤ z′ ≤ roi_z_max_m`, both
+//! extents positive.
 //!
 //! NaN and infinities are out of range for every f32 word. The words round-trip exactly
 //! (`from_words(p.to_words()) == Ok(p)`), and [`KernelParams::hash`] is FNV-1a over their
@@ -50,11 +60,21 @@ pub enum Param {
     SplitGapNs = 8,
     /// [`KernelParams::split_geometry`].
     SplitGeometry = 9,
+    /// [`KernelParams::roi_x_min_m`].
+    RoiXMinM = 10,
+    /// [`KernelParams::roi_x_max_m`].
+    RoiXMaxM = 11,
+    /// [`KernelParams::roi_z_min_m`].
+    RoiZMinM = 12,
+    /// [`KernelParams::roi_z_max_m`].
+    RoiZMaxM = 13,
+    /// [`KernelParams::output_mode`].
+    OutputMode = 14,
 }
 
 impl Param {
     /// Every parameter, in word order.
-    pub const ALL: [Param; 10] = [
+    pub const ALL: [Param; 15] = [
         Param::DBM,
         Param::IrregularDeg,
         Param::TauMinDeg,
@@ -65,6 +85,11 @@ impl Param {
         Param::SmoothGapM,
         Param::SplitGapNs,
         Param::SplitGeometry,
+        Param::RoiXMinM,
+        Param::RoiXMaxM,
+        Param::RoiZMinM,
+        Param::RoiZMaxM,
+        Param::OutputMode,
     ];
 
     /// Index of the parameter's config word.
@@ -85,6 +110,11 @@ impl Param {
             Param::SmoothGapM => "smooth_gap_m",
             Param::SplitGapNs => "split_gap_ns",
             Param::SplitGeometry => "split_geometry",
+            Param::RoiXMinM => "roi_x_min_m",
+            Param::RoiXMaxM => "roi_x_max_m",
+            Param::RoiZMinM => "roi_z_min_m",
+            Param::RoiZMaxM => "roi_z_max_m",
+            Param::OutputMode => "output_mode",
         }
     }
 
@@ -102,6 +132,11 @@ impl Param {
             Param::SmoothGapM => "[0, 100]",
             Param::SplitGapNs => "any u32",
             Param::SplitGeometry => "0..=2 (0 = auto, 1 = always, 2 = never)",
+            Param::RoiXMinM => "[-2000, 2000] (all four roi_* 0 = no region)",
+            Param::RoiXMaxM => "(roi_x_min_m, 2000] (all four roi_* 0 = no region)",
+            Param::RoiZMinM => "[-2000, 2000] (all four roi_* 0 = no region)",
+            Param::RoiZMaxM => "(roi_z_min_m, 2000] (all four roi_* 0 = no region)",
+            Param::OutputMode => "0..=1 (0 = points, 1 = candidates)",
         }
     }
 
@@ -109,7 +144,7 @@ impl Param {
     pub const fn is_f32(self) -> bool {
         !matches!(
             self,
-            Param::TaubinSteps | Param::SplitGapNs | Param::SplitGeometry
+            Param::TaubinSteps | Param::SplitGapNs | Param::SplitGeometry | Param::OutputMode
         )
     }
 }
@@ -238,10 +273,64 @@ pub struct KernelParams {
     /// 0 = until the stream's first line-start flag ([`GeometrySplit::Auto`], the default),
     /// 1 = always, 2 = never.
     pub split_geometry: u32,
+    /// Region of interest, smallest x′ in metres (wire version 2). Points outside the box
+    /// `roi_x_min_m..=roi_x_max_m` × `roi_z_min_m..=roi_z_max_m` are counted and get
+    /// [`super::PointStatus::OutsideRoi`] with their raw coordinates; the kernel runs on the
+    /// points inside as if the others were not there. All four `roi_*` 0 (the default): no
+    /// region, every point is processed.
+    ///
+    /// A region is a deployment choice (the scanner's mounting, the lateral range where
+    /// curbs are searched), not part of the method: the host's own extraction runs without
+    /// one unless its config sets one.
+    pub roi_x_min_m: f32,
+    /// Region of interest, largest x′ in metres (see [`Self::roi_x_min_m`]).
+    pub roi_x_max_m: f32,
+    /// Region of interest, smallest z′ in metres (see [`Self::roi_x_min_m`]).
+    pub roi_z_min_m: f32,
+    /// Region of interest, largest z′ in metres (see [`Self::roi_x_min_m`]).
+    pub roi_z_max_m: f32,
+    /// What the core sends per line (wire version 2): 0 = output packets with every point
+    /// (kind 3), 1 = a candidates packet only (kind 4: the nadir, both seed candidates and
+    /// the counters). Default 0.
+    pub output_mode: u32,
 }
 
 /// Index of the first reserved word.
-const FIRST_RESERVED: usize = 10;
+const FIRST_RESERVED: usize = 15;
+
+/// The largest |coordinate| of a region-of-interest bound, metres.
+const ROI_LIMIT_M: f32 = 2000.0;
+
+/// The region of interest of [`KernelParams`], when one is set.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Roi {
+    /// Smallest x′, metres.
+    pub x_min: f32,
+    /// Largest x′, metres.
+    pub x_max: f32,
+    /// Smallest z′, metres.
+    pub z_min: f32,
+    /// Largest z′, metres.
+    pub z_max: f32,
+}
+
+impl Roi {
+    /// Whether (x′, z′) lies in the box (bounds included; NaN never does).
+    #[inline(always)]
+    pub fn contains(&self, x: f32, z: f32) -> bool {
+        x >= self.x_min && x <= self.x_max && z >= self.z_min && z <= self.z_max
+    }
+}
+
+/// What the core sends per line ([`KernelParams::output_mode`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum OutputMode {
+    /// Output packets with every point (kind 3).
+    Points,
+    /// One candidates packet per line (kind 4).
+    Candidates,
+}
 
 impl KernelParams {
     /// The defaults (see each field for how its value was chosen).
@@ -256,6 +345,11 @@ impl KernelParams {
         smooth_gap_m: 0.30,
         split_gap_ns: 5_000_000,
         split_geometry: 0,
+        roi_x_min_m: 0.0,
+        roi_x_max_m: 0.0,
+        roi_z_min_m: 0.0,
+        roi_z_max_m: 0.0,
+        output_mode: 0,
     };
 
     /// The parameter block as config-packet words (see the module's table).
@@ -271,7 +365,31 @@ impl KernelParams {
         w[7] = self.smooth_gap_m.to_bits();
         w[8] = self.split_gap_ns;
         w[9] = self.split_geometry;
+        w[10] = self.roi_x_min_m.to_bits();
+        w[11] = self.roi_x_max_m.to_bits();
+        w[12] = self.roi_z_min_m.to_bits();
+        w[13] = self.roi_z_max_m.to_bits();
+        w[14] = self.output_mode;
         w
+    }
+
+    /// The region of interest, if one is set.
+    pub fn roi(&self) -> Option<Roi> {
+        (self.roi_x_min_m < self.roi_x_max_m).then_some(Roi {
+            x_min: self.roi_x_min_m,
+            x_max: self.roi_x_max_m,
+            z_min: self.roi_z_min_m,
+            z_max: self.roi_z_max_m,
+        })
+    }
+
+    /// What the core sends per line.
+    pub fn output_mode(&self) -> OutputMode {
+        if self.output_mode == 1 {
+            OutputMode::Candidates
+        } else {
+            OutputMode::Points
+        }
     }
 
     /// Parses and checks a parameter block; the first offending word is reported.
@@ -319,6 +437,19 @@ impl KernelParams {
         let smooth_gap_m = f(words, Param::SmoothGapM, 0.0, false, 100.0, false)?;
         let split_gap_ns = words[Param::SplitGapNs.word()];
         let split_geometry = int(words, Param::SplitGeometry, 2)?;
+        let l = ROI_LIMIT_M;
+        let roi_x_min_m = f(words, Param::RoiXMinM, -l, false, l, false)?;
+        let roi_z_min_m = f(words, Param::RoiZMinM, -l, false, l, false)?;
+        let off = (10..14).all(|i| words[i] == 0);
+        let (roi_x_max_m, roi_z_max_m) = if off {
+            (0.0, 0.0)
+        } else {
+            (
+                f(words, Param::RoiXMaxM, roi_x_min_m, true, l, false)?,
+                f(words, Param::RoiZMaxM, roi_z_min_m, true, l, false)?,
+            )
+        };
+        let output_mode = int(words, Param::OutputMode, 1)?;
         Ok(Self {
             d_b_m,
             irregular_deg,
@@ -330,6 +461,11 @@ impl KernelParams {
             smooth_gap_m,
             split_gap_ns,
             split_geometry,
+            roi_x_min_m,
+            roi_x_max_m,
+            roi_z_min_m,
+            roi_z_max_m,
+            output_mode,
         })
     }
 

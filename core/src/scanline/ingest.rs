@@ -12,6 +12,7 @@ use super::Line;
 use crate::wire::{
     scan_two, Error as WireError, GarbageReason, Packet, PacketKind, PointRecord, Scan,
     CONFIG_WORDS, HEADER_LEN, MAX_PACKET_LEN, POINTS_PREFIX_LEN, POINT_RECORD_LEN, VERSION,
+    VERSION_1, config_version,
 };
 
 /// What [`Ingest::poll`] produced.
@@ -376,12 +377,16 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
             counter(&mut s.c);
             Step::Continue
         };
-        if view.version() != VERSION {
+        let version = view.version();
+        if version.wrapping_sub(VERSION_1) > VERSION - VERSION_1 {
             return reject(self, |c| c.bad_version += 1);
         }
         let Some(kind) = kind else {
             return reject(self, |c| c.bad_kind += 1);
         };
+        if version < kind.min_version() {
+            return reject(self, |c| c.bad_version += 1);
+        }
         if !kind.length_ok(len) {
             return reject(self, |c| c.bad_kind_length += 1);
         }
@@ -426,6 +431,9 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
                     let _ = self.ring.peek(HEADER_LEN + 4 * i, &mut b);
                     *w = u32::from_le_bytes(b);
                 }
+                if version < config_version(&words) {
+                    return reject(self, |c| c.bad_version += 1);
+                }
                 self.ring.consume(len);
                 self.c.bytes_packets += len as u64;
                 self.c.packets_config += 1;
@@ -439,7 +447,7 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
                 }
                 Step::Config(words)
             }
-            PacketKind::Output => {
+            PacketKind::Output | PacketKind::Candidates => {
                 self.ring.consume(len);
                 self.c.bytes_rejected += len as u64;
                 self.c.output_ignored += 1;

@@ -3,7 +3,7 @@
 use super::output::{emit_output_fragment, emit_output_fragment_columns};
 use super::points::emit_points;
 use super::{
-    ConfigRepr, EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr, PointRecord,
+    CandidatesRepr, ConfigRepr, EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr, PointRecord,
     CONFIG_WORDS, MAX_OUTPUT_POINTS_PER_PACKET,
 };
 
@@ -45,6 +45,17 @@ impl StreamEncoder {
         out: &mut [u8],
     ) -> Result<usize, EncodeError> {
         let r = ConfigRepr { words: *words }.emit(self.seq, out);
+        self.bump(r)
+    }
+
+    /// Writes a candidates packet (version 2): one line's nadir and seed candidates.
+    /// Returns its length ([`super::CANDIDATES_PACKET_LEN`]).
+    pub fn encode_candidates(
+        &mut self,
+        repr: &CandidatesRepr,
+        out: &mut [u8],
+    ) -> Result<usize, EncodeError> {
+        let r = repr.emit(self.seq, out);
         self.bump(r)
     }
 

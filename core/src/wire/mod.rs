@@ -8,7 +8,9 @@
 //!   [`MAX_POINTS_PER_PACKET`] point records;
 //! - **config** ([`ConfigRepr`]) — the [`CONFIG_WORDS`] parameter words of the kernel;
 //! - **output** ([`OutputHeaderRepr`], [`OutputPointRepr`]) — one fragment of the kernel's
-//!   result for one scanline.
+//!   result for one scanline;
+//! - **candidates** ([`CandidatesRepr`], version 2) — one scanline's nadir and seed
+//!   candidates only.
 //!
 //! The layer follows smoltcp's shape: [`Packet`] is a zero-copy view over bytes whose field
 //! offsets live in the private `field` module, the `*Repr` types are checked, owned
@@ -50,8 +52,8 @@ mod scan;
 
 pub use encoder::StreamEncoder;
 pub use output::{
-    OutputColumns, OutputHeaderRepr, OutputPointRepr, OutputPoints, OUTPUT_HEADER_LEN,
-    OUTPUT_POINT_LEN,
+    CandidatesRepr, OutputColumns, OutputHeaderRepr, OutputPointRepr, OutputPoints,
+    CANDIDATES_PACKET_LEN, OUTPUT_HEADER_LEN, OUTPUT_POINT_LEN,
 };
 pub use points::{PointRecord, PointsRepr, POINT_FLAG_LINE_START, POINT_RECORD_LEN};
 pub(crate) use scan::copy_from_two;
@@ -59,8 +61,14 @@ pub use scan::{scan, scan_two, GarbageReason, Scan};
 
 /// The two sync bytes that open every packet (`A5 C3`; in little-endian as a `u16`: 0xC3A5).
 pub const SYNC: [u8; 2] = [0xA5, 0xC3];
-/// The format version this code reads and writes.
-pub const VERSION: u8 = 1;
+/// The newest format version this code reads and writes. A writer gives each packet the
+/// lowest version that expresses it ([`VERSION_1`] unless the packet uses a field of
+/// version 2), so a stream without version-2 features is byte for byte a version-1 stream.
+pub const VERSION: u8 = 2;
+/// The first version, still read.
+pub const VERSION_1: u8 = 1;
+/// Config words a version-1 config packet may set (the rest must be zero in version 1).
+pub const CONFIG_WORDS_V1: usize = 10;
 /// Length of the common header in bytes.
 pub const HEADER_LEN: usize = 12;
 /// Length of the trailing CRC in bytes.
@@ -140,7 +148,8 @@ mod field {
         pub const IRREGULAR: Field = 44..46;
         pub const NO_NEIGHBOUR: Field = 46..48;
         pub const PEAKS: Field = 48..50;
-        pub const RESERVED: Field = 50..52;
+        /// Reserved (zero) in version 1; points outside the region of interest in 2.
+        pub const OUTSIDE: Field = 50..52;
         pub const POINTS: usize = 52;
     }
 
@@ -170,7 +179,8 @@ pub enum Error {
     },
     /// The first two bytes are not [`SYNC`].
     BadSync,
-    /// The version byte is not [`VERSION`].
+    /// The version byte is not one this code reads (1 or [`VERSION`]), or names a
+    /// version older than a field the packet uses.
     BadVersion {
         /// The version found.
         version: u8,
@@ -257,7 +267,7 @@ impl core::fmt::Display for Error {
             Error::BadSync => write!(f, "packet does not start with the sync bytes A5 C3"),
             Error::BadVersion { version } => write!(
                 f,
-                "packet has format version {version}, this code reads version {VERSION}"
+                "packet has format version {version}, this code reads versions {VERSION_1}..={VERSION} (version 2 for the fields it uses)"
             ),
             Error::BadKind { kind } => write!(f, "packet kind {kind} is not a known kind"),
             Error::BadLength { length } => write!(
@@ -330,15 +340,26 @@ pub enum PacketKind {
     Config = 2,
     /// One fragment of one scanline's kernel output (core → host).
     Output = 3,
+    /// One scanline's nadir and seed candidates only (core → host; version 2).
+    Candidates = 4,
 }
 
 impl PacketKind {
+    /// The first format version that has this kind.
+    pub const fn min_version(self) -> u8 {
+        match self {
+            Self::Candidates => 2,
+            _ => VERSION_1,
+        }
+    }
+
     /// The kind for byte `b`, if any.
     pub const fn from_u8(b: u8) -> Option<Self> {
         match b {
             1 => Some(Self::Points),
             2 => Some(Self::Config),
             3 => Some(Self::Output),
+            4 => Some(Self::Candidates),
             _ => None,
         }
     }
@@ -359,6 +380,7 @@ impl PacketKind {
                     && (length - fixed).is_multiple_of(OUTPUT_POINT_LEN)
                     && (length - fixed) / OUTPUT_POINT_LEN <= MAX_OUTPUT_POINTS_PER_PACKET
             }
+            Self::Candidates => length == CANDIDATES_PACKET_LEN,
         }
     }
 }
@@ -410,10 +432,10 @@ fn seal(buf: &mut [u8], length: usize) {
     put_bytes(buf, body, &crc.to_le_bytes());
 }
 
-/// Writes the common header.
-fn emit_header(buf: &mut [u8], kind: PacketKind, length: u16, seq: u32) {
+/// Writes the common header with format version `version`.
+fn emit_header(buf: &mut [u8], version: u8, kind: PacketKind, length: u16, seq: u32) {
     put_bytes(buf, field::SYNC.start, &SYNC);
-    put_bytes(buf, field::VERSION, &[VERSION]);
+    put_bytes(buf, field::VERSION, &[version]);
     put_bytes(buf, field::KIND, &[kind as u8]);
     put_bytes(buf, field::LENGTH.start, &length.to_le_bytes());
     put_bytes(buf, field::FLAGS.start, &0u16.to_le_bytes());
@@ -477,14 +499,16 @@ impl<T: AsRef<[u8]>> Packet<T> {
         if computed != stored {
             return Err(Error::Crc { stored, computed });
         }
-        if self.version() != VERSION {
-            return Err(Error::BadVersion {
-                version: self.version(),
-            });
+        let version = self.version();
+        if !(VERSION_1..=VERSION).contains(&version) {
+            return Err(Error::BadVersion { version });
         }
         let kind = PacketKind::from_u8(self.kind_raw()).ok_or(Error::BadKind {
             kind: self.kind_raw(),
         })?;
+        if version < kind.min_version() {
+            return Err(Error::BadVersion { version });
+        }
         if !kind.length_ok(self.length()) {
             return Err(Error::BadLength {
                 length: self.length(),
@@ -573,6 +597,16 @@ impl<T: AsRef<[u8]>> Packet<T> {
     }
 }
 
+/// The lowest format version whose config packet carries `words` (see
+/// [`ConfigRepr::version`]).
+pub fn config_version(words: &[u32; CONFIG_WORDS]) -> u8 {
+    if words.iter().skip(CONFIG_WORDS_V1).all(|&w| w == 0) {
+        VERSION_1
+    } else {
+        VERSION
+    }
+}
+
 /// The parameter words of a config packet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -593,7 +627,19 @@ impl ConfigRepr {
         for (w, chunk) in words.iter_mut().zip(p.chunks_exact(4)) {
             *w = u32::from_le_bytes(get_bytes(chunk, 0));
         }
-        Ok(Self { words })
+        let repr = Self { words };
+        if packet.version() < repr.version() {
+            return Err(Error::BadVersion {
+                version: packet.version(),
+            });
+        }
+        Ok(repr)
+    }
+
+    /// The lowest format version that carries these words: 1 when the words of version 2
+    /// (from [`CONFIG_WORDS_V1`] on) are all zero, else 2.
+    pub fn version(&self) -> u8 {
+        config_version(&self.words)
     }
 
     /// Writes the packet with sequence number `seq` into `out`; returns its length.
@@ -606,7 +652,7 @@ impl ConfigRepr {
             });
         }
         let len16 = u16::try_from(len).map_err(|_| EncodeError::OutOfRange { index: 0 })?;
-        emit_header(out, PacketKind::Config, len16, seq);
+        emit_header(out, self.version(), PacketKind::Config, len16, seq);
         for (i, w) in self.words.iter().enumerate() {
             put_bytes(out, field::PAYLOAD + 4 * i, &w.to_le_bytes());
         }

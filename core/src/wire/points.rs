@@ -2,6 +2,7 @@
 
 use super::{
     emit_header, field, get_bytes, put_bytes, seal, EncodeError, Error, Packet, PacketKind,
+    VERSION_1,
     CRC_LEN, HEADER_LEN, MAX_POINTS_PER_PACKET, POINTS_PREFIX_LEN,
 };
 
@@ -163,7 +164,7 @@ pub(super) fn emit_points(
         count: points.len(),
         max: MAX_POINTS_PER_PACKET,
     })?;
-    emit_header(out, PacketKind::Points, len16, seq);
+    emit_header(out, VERSION_1, PacketKind::Points, len16, seq);
     put_bytes(out, field::BASE_TIME.start, &base_time_ns.to_le_bytes());
     for (i, (p, rec)) in points
         .iter()

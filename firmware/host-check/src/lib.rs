@@ -1,14 +1,15 @@
-//! Reading and comparing streams of output packets (`docs/wire-format.md`, "Output"), for
-//! `firmware/check.sh`: the firmware's output against the host core's.
+//! Reading and comparing streams of output packets (`docs/wire-format.md`, "Output" and
+//! "Candidates"), for `firmware/check.sh`: the firmware's output against the host core's.
 
-use curbtrace_core::wire::{OutputHeaderRepr, OutputPointRepr, Packet};
+use curbtrace_core::wire::{CandidatesRepr, OutputHeaderRepr, OutputPointRepr, Packet, PacketKind};
 
 /// One scanline's result, reassembled from its output packets.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LineResult {
     /// The line header (with `first` = 0).
     pub header: OutputHeaderRepr,
-    /// Every point of the line, in order.
+    /// Every point of the line, in order (of a candidates packet: the records it carries,
+    /// nadir, left, right).
     pub points: Vec<OutputPointRepr>,
     /// The raw bytes of the line's packets, back to back.
     pub bytes: Vec<u8>,
@@ -46,7 +47,8 @@ impl std::fmt::Display for ReadError {
 
 impl std::error::Error for ReadError {}
 
-/// Splits a results stream (output packets back to back, nothing else) into lines.
+/// Splits a results stream (output or candidates packets back to back, nothing else) into
+/// lines.
 pub fn read_lines(stream: &[u8]) -> Result<Vec<LineResult>, ReadError> {
     let mut lines: Vec<LineResult> = Vec::new();
     let mut at = 0;
@@ -55,6 +57,16 @@ pub fn read_lines(stream: &[u8]) -> Result<Vec<LineResult>, ReadError> {
         let packet = Packet::new_checked(&stream[at..]).map_err(|e| bad(format!("{e:?}")))?;
         let len = packet.length();
         let packet = Packet::new_unchecked(&stream[at..at + len]);
+        if packet.kind() == Some(PacketKind::Candidates) {
+            let c = CandidatesRepr::parse(&packet).map_err(|e| bad(format!("{e:?}")))?;
+            lines.push(LineResult {
+                header: c.header,
+                points: [c.nadir, c.left, c.right].into_iter().flatten().collect(),
+                bytes: stream[at..at + len].to_vec(),
+            });
+            at += len;
+            continue;
+        }
         let (header, points) =
             OutputHeaderRepr::parse(&packet).map_err(|e| bad(format!("{e:?}")))?;
         if header.first == 0 {

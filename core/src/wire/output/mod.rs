@@ -12,8 +12,10 @@
 //!
 //! One file per subject: `packet` — the line header, parsing a packet and writing one
 //! fragment point by point; `point` — one output point, its scaling and its record words;
-//! `columns` — the encoder's fast path for a line given as columns.
+//! `columns` — the encoder's fast path for a line given as columns; `candidates` — the
+//! version-2 packet that carries only a line's nadir and candidates.
 
+mod candidates;
 mod columns;
 mod packet;
 mod point;
@@ -23,6 +25,7 @@ mod tests;
 use super::{CRC_LEN, HEADER_LEN};
 
 pub(super) use columns::emit_output_fragment_columns;
+pub use candidates::{CandidatesRepr, CANDIDATES_PACKET_LEN};
 pub use columns::OutputColumns;
 pub(super) use packet::emit_output_fragment;
 pub use packet::{OutputHeaderRepr, OutputPoints};

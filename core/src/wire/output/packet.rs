@@ -3,7 +3,7 @@
 
 use super::super::{
     emit_header, field, get_u16, get_u32, get_u64, put_bytes, seal, EncodeError, Error, Packet,
-    PacketKind, CRC_LEN, MAX_OUTPUT_POINTS_PER_PACKET,
+    PacketKind, CRC_LEN, MAX_OUTPUT_POINTS_PER_PACKET, VERSION, VERSION_1,
 };
 use super::{output_packet_len, OutputPointRepr, NO_INDEX, OUTPUT_POINT_LEN};
 
@@ -37,6 +37,10 @@ pub struct OutputHeaderRepr {
     pub no_neighbour: u16,
     /// Kernel counter: peaks found.
     pub peaks: u16,
+    /// Points of the line outside the region of interest (not processed by the kernel).
+    /// Version 2: a packet with a non-zero count is written as version 2; in version 1 the
+    /// field is reserved and zero.
+    pub outside: u16,
 }
 
 impl OutputHeaderRepr {
@@ -54,8 +58,71 @@ impl OutputHeaderRepr {
             .ok_or(EncodeError::OutOfRange { index: k })
     }
 
+    /// The lowest format version that carries this header.
+    pub fn version(&self) -> u8 {
+        if self.outside != 0 {
+            VERSION
+        } else {
+            VERSION_1
+        }
+    }
+
+    /// Reads the line header of an output or candidates packet whose envelope has been
+    /// checked, and checks the fields the two kinds share (the version against `outside`,
+    /// the indices against `line_len`).
+    pub(super) fn read(b: &[u8], version: u8) -> Result<Self, Error> {
+        use field::out;
+        let h = Self {
+            index: get_u32(b, out::INDEX),
+            start_time_ns: get_u64(b, out::START_TIME),
+            params_hash: get_u32(b, out::PARAMS_HASH),
+            truncated: get_u32(b, out::TRUNCATED),
+            line_len: get_u16(b, out::LINE_LEN),
+            first: get_u16(b, out::FIRST),
+            nadir: opt_index(get_u16(b, out::NADIR)),
+            left: opt_index(get_u16(b, out::LEFT)),
+            right: opt_index(get_u16(b, out::RIGHT)),
+            kept: get_u16(b, out::KEPT),
+            irregular: get_u16(b, out::IRREGULAR),
+            no_neighbour: get_u16(b, out::NO_NEIGHBOUR),
+            peaks: get_u16(b, out::PEAKS),
+            outside: get_u16(b, out::OUTSIDE),
+        };
+        if version < h.version() {
+            return Err(Error::ReservedNotZero {
+                offset: out::OUTSIDE.start,
+            });
+        }
+        if !h.indices_ok() {
+            return Err(Error::OutOfRange {
+                offset: out::NADIR.start,
+            });
+        }
+        Ok(h)
+    }
+
+    /// Writes the line header (with `first`) after the packet header.
+    pub(super) fn put(&self, first: u16, out: &mut [u8]) {
+        use field::out as f;
+        let idx = |v: Option<u16>| v.unwrap_or(NO_INDEX).to_le_bytes();
+        put_bytes(out, f::INDEX.start, &self.index.to_le_bytes());
+        put_bytes(out, f::START_TIME.start, &self.start_time_ns.to_le_bytes());
+        put_bytes(out, f::PARAMS_HASH.start, &self.params_hash.to_le_bytes());
+        put_bytes(out, f::TRUNCATED.start, &self.truncated.to_le_bytes());
+        put_bytes(out, f::LINE_LEN.start, &self.line_len.to_le_bytes());
+        put_bytes(out, f::FIRST.start, &first.to_le_bytes());
+        put_bytes(out, f::NADIR.start, &idx(self.nadir));
+        put_bytes(out, f::LEFT.start, &idx(self.left));
+        put_bytes(out, f::RIGHT.start, &idx(self.right));
+        put_bytes(out, f::KEPT.start, &self.kept.to_le_bytes());
+        put_bytes(out, f::IRREGULAR.start, &self.irregular.to_le_bytes());
+        put_bytes(out, f::NO_NEIGHBOUR.start, &self.no_neighbour.to_le_bytes());
+        put_bytes(out, f::PEAKS.start, &self.peaks.to_le_bytes());
+        put_bytes(out, f::OUTSIDE.start, &self.outside.to_le_bytes());
+    }
+
     /// Checks the index fields against `line_len`.
-    fn indices_ok(&self) -> bool {
+    pub(super) fn indices_ok(&self) -> bool {
         [self.nadir, self.left, self.right]
             .iter()
             .all(|i| i.is_none_or(|v| v < self.line_len))
@@ -97,31 +164,7 @@ impl OutputHeaderRepr {
         }
         let b = packet.bytes();
         use field::out;
-        let h = Self {
-            index: get_u32(b, out::INDEX),
-            start_time_ns: get_u64(b, out::START_TIME),
-            params_hash: get_u32(b, out::PARAMS_HASH),
-            truncated: get_u32(b, out::TRUNCATED),
-            line_len: get_u16(b, out::LINE_LEN),
-            first: get_u16(b, out::FIRST),
-            nadir: opt_index(get_u16(b, out::NADIR)),
-            left: opt_index(get_u16(b, out::LEFT)),
-            right: opt_index(get_u16(b, out::RIGHT)),
-            kept: get_u16(b, out::KEPT),
-            irregular: get_u16(b, out::IRREGULAR),
-            no_neighbour: get_u16(b, out::NO_NEIGHBOUR),
-            peaks: get_u16(b, out::PEAKS),
-        };
-        if get_u16(b, out::RESERVED) != 0 {
-            return Err(Error::ReservedNotZero {
-                offset: out::RESERVED.start,
-            });
-        }
-        if !h.indices_ok() {
-            return Err(Error::OutOfRange {
-                offset: out::NADIR.start,
-            });
-        }
+        let h = Self::read(b, packet.version())?;
         let pts = b
             .get(out::POINTS..b.len().saturating_sub(CRC_LEN))
             .unwrap_or(&[]);
@@ -199,31 +242,8 @@ pub(super) fn begin_fragment(
         count,
         max: MAX_OUTPUT_POINTS_PER_PACKET,
     })?;
-    emit_header(out, PacketKind::Output, len16, seq);
-    use field::out as f;
-    let idx = |v: Option<u16>| v.unwrap_or(NO_INDEX).to_le_bytes();
-    put_bytes(out, f::INDEX.start, &header.index.to_le_bytes());
-    put_bytes(
-        out,
-        f::START_TIME.start,
-        &header.start_time_ns.to_le_bytes(),
-    );
-    put_bytes(out, f::PARAMS_HASH.start, &header.params_hash.to_le_bytes());
-    put_bytes(out, f::TRUNCATED.start, &header.truncated.to_le_bytes());
-    put_bytes(out, f::LINE_LEN.start, &header.line_len.to_le_bytes());
-    put_bytes(out, f::FIRST.start, &first.to_le_bytes());
-    put_bytes(out, f::NADIR.start, &idx(header.nadir));
-    put_bytes(out, f::LEFT.start, &idx(header.left));
-    put_bytes(out, f::RIGHT.start, &idx(header.right));
-    put_bytes(out, f::KEPT.start, &header.kept.to_le_bytes());
-    put_bytes(out, f::IRREGULAR.start, &header.irregular.to_le_bytes());
-    put_bytes(
-        out,
-        f::NO_NEIGHBOUR.start,
-        &header.no_neighbour.to_le_bytes(),
-    );
-    put_bytes(out, f::PEAKS.start, &header.peaks.to_le_bytes());
-    put_bytes(out, f::RESERVED.start, &0u16.to_le_bytes());
+    emit_header(out, header.version(), PacketKind::Output, len16, seq);
+    header.put(first, out);
     Ok((count, len))
 }
 
