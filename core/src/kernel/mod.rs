@@ -19,16 +19,17 @@
 //!    indexed by input point again; set-aside points get their raw coordinates back.
 //!
 //! With a region of interest ([`KernelParams::roi`]), the points inside it are first moved
-//! to the front the same way (step 0), steps 1–6 run on them alone, and that partition is
-//! undone last; the points outside keep their raw coordinates, ρ = 0 and
-//! [`PointStatus::OutsideRoi`].
+//! to the front the same way, tags included (step 0), and steps 1–6 run on them alone. That
+//! partition is not undone: the line's output lists the points inside in input order,
+//! then the points outside (raw coordinates, ρ = 0, [`PointStatus::OutsideRoi`]) in the
+//! partition's order; the tags join each point to its source. Undoing it cost more than
+//! the rest of the kernel saved on the points outside (`docs/benchmarks.md`).
 //!
 //! # Memory
 //!
 //! Per point of capacity `N`: the line's x′, z′, tag (12 bytes) plus the kernel's ρ (`f32`),
-//! status (`u8`), two `u8` of working space (the window's ends as offsets; the right one
-//! later holds the status of a kept point) and the region-of-interest mark (`bool`) — 20
-//! bytes — plus a 1 KiB deque for the peak search and the parameters.
+//! status (`u8`) and two `u8` of working space (the window's ends as offsets; the right one
+//! later holds the status of a kept point) — 19 bytes — plus a 1 KiB deque for the peak search and the parameters.
 //! ρ's buffer doubles as the smoothing scratch before ρ is computed.
 
 use crate::math::{self, Maths};
@@ -108,7 +109,9 @@ pub struct KernelCounters {
 }
 
 /// The kernel's result for one scanline, borrowed from the kernel's buffers (no copies).
-/// Index `i` of every slice is input point `i` of the line.
+/// Index `i` of every slice is input point `i` of the line — or, with a region of
+/// interest, the points inside in input order followed by the points outside (join by
+/// `tag`).
 pub struct ScanlineOutput<'a> {
     /// Scanline number in the stream.
     pub index: u32,
@@ -177,8 +180,7 @@ pub struct Kernel<const N: usize> {
     aux: [u8; N],
     /// Per point: i − s(i).
     s_off: [u8; N],
-    /// Per input point: inside the region of interest (written only when one is set).
-    inside: [bool; N],
+
     /// The peak search's window-maximum deque.
     deque: [u16; seed::DEQUE_LEN],
     /// `params_hash` and `derived` are still to be computed from `params` (a kernel made
@@ -203,7 +205,6 @@ impl<const N: usize> Kernel<N> {
             status: [PointStatus::Kept; N],
             aux: [0; N],
             s_off: [0; N],
-            inside: [false; N],
             deque: [0; seed::DEQUE_LEN],
             fresh: true,
         }
@@ -245,14 +246,14 @@ impl<const N: usize> Kernel<N> {
         let p = self.params;
         let Derived { d2, irregular } = self.derived;
         // 0. The points inside the region of interest to the front, in order.
-        let (n, first_roi_out) = match p.roi() {
+        let n = match p.roi() {
             Some(roi) => roi_partition(
                 &mut line.x_m[..n_all],
                 &mut line.z_m[..n_all],
-                &mut self.inside[..n_all],
+                &mut line.tag[..n_all],
                 roi,
             ),
-            None => (n_all, n_all),
+            None => n_all,
         };
         let mut c = KernelCounters {
             points_in: n_all as u32,
@@ -331,21 +332,9 @@ impl<const N: usize> Kernel<N> {
         } else {
             idx = unpartition(x, z, rho, status, aux, first_out, kept, idx);
         }
-        // 7. The points outside the region of interest back in place.
-        if n < n_all {
-            self.rho[n..n_all].fill(0.0);
-            self.status[n..n_all].fill(PointStatus::OutsideRoi);
-            idx = roi_unpartition(
-                &mut line.x_m[..n_all],
-                &mut line.z_m[..n_all],
-                &mut self.rho[..n_all],
-                &mut self.status[..n_all],
-                &self.inside[..n_all],
-                first_roi_out,
-                n,
-                idx,
-            );
-        }
+        // 7. The points outside the region of interest, behind the others.
+        self.rho[n..n_all].fill(0.0);
+        self.status[n..n_all].fill(PointStatus::OutsideRoi);
         let [nadir, left, right] = idx.map(|o| o.map(|i| i as u16));
 
         ScanlineOutput {
@@ -424,74 +413,35 @@ fn unpartition(
     map
 }
 
-/// Step 0 of [`Kernel::process`] with a region of interest: marks every point in
-/// `inside` and moves the points inside to the front, in order (a Lomuto partition from
-/// the first point outside). Returns (points inside, index of the first point outside).
+/// Step 0 of [`Kernel::process`] with a region of interest: moves the points inside to
+/// the front, in order, with their tags (a Lomuto partition from the first point outside;
+/// the points outside end up behind them in the partition's order). Returns the number of
+/// points inside.
 #[inline(never)]
-fn roi_partition(x: &mut [f32], z: &mut [f32], inside: &mut [bool], roi: Roi) -> (usize, usize) {
-    let n = inside.len();
+fn roi_partition(x: &mut [f32], z: &mut [f32], tag: &mut [u32], roi: Roi) -> usize {
+    let n = tag.len();
     let (x, z) = (&mut x[..n], &mut z[..n]);
-    let mut first_out = n;
+    let mut w = n;
     for i in 0..n {
-        let ins = roi.contains(x[i], z[i]);
-        inside[i] = ins;
-        if !ins {
-            first_out = i;
+        if !roi.contains(x[i], z[i]) {
+            w = i;
             break;
         }
     }
-    let mut w = first_out;
-    for i in first_out.saturating_add(1)..n {
+    for i in w.saturating_add(1)..n {
         let (xi, zi) = (x[i], z[i]);
-        let ins = roi.contains(xi, zi);
-        inside[i] = ins;
-        if ins {
+        if roi.contains(xi, zi) {
+            let ti = tag[i];
             x[i] = x[w];
             z[i] = z[w];
+            tag[i] = tag[w];
             x[w] = xi;
             z[w] = zi;
+            tag[w] = ti;
             w += 1;
         }
     }
-    (w, first_out)
-}
-
-/// Step 7 of [`Kernel::process`]: replays [`roi_partition`]'s swaps backwards on the
-/// coordinates, ρ and status (the points outside sit at `inside_count..` with their ρ and
-/// status already set), and maps the indices `idx` (among the points inside) back to input
-/// indices.
-#[allow(clippy::too_many_arguments)]
-#[inline(never)]
-fn roi_unpartition(
-    x: &mut [f32],
-    z: &mut [f32],
-    rho: &mut [f32],
-    status: &mut [PointStatus],
-    inside: &[bool],
-    first_out: usize,
-    inside_count: usize,
-    idx: [Option<usize>; 3],
-) -> [Option<usize>; 3] {
-    let n = inside.len();
-    let (x, z, rho, status) = (&mut x[..n], &mut z[..n], &mut rho[..n], &mut status[..n]);
-    let want = idx.map(|o| o.unwrap_or(usize::MAX));
-    let mut map = idx;
-    let mut w = inside_count;
-    for i in (first_out..n).rev() {
-        if inside[i] {
-            w -= 1;
-            x.swap(w, i);
-            z.swap(w, i);
-            rho.swap(w, i);
-            status.swap(w, i);
-            for (m, &o) in map.iter_mut().zip(want.iter()) {
-                if o == w {
-                    *m = Some(i);
-                }
-            }
-        }
-    }
-    map
+    w
 }
 
 /// The status a kept point's `u8` in the working buffer stands for.

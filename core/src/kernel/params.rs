@@ -563,6 +563,11 @@ mod tests {
             smooth_gap_m: 0.0,
             split_gap_ns: 0,
             split_geometry: 0,
+            roi_x_min_m: 0.0,
+            roi_x_max_m: 0.0,
+            roi_z_min_m: 0.0,
+            roi_z_max_m: 0.0,
+            output_mode: 0,
         };
         assert_eq!(zero.hash(), expect);
         let a = KernelParams::DEFAULT;
@@ -577,7 +582,7 @@ mod tests {
     #[test]
     fn bad_words_are_rejected_naming_their_parameter() {
         let good = KernelParams::DEFAULT.to_words();
-        let cases: [(Param, u32); 12] = [
+        let cases: [(Param, u32); 14] = [
             (Param::DBM, f32::NAN.to_bits()),
             (Param::DBM, 0.0f32.to_bits()),
             (Param::DBM, (-0.1f32).to_bits()),
@@ -590,6 +595,8 @@ mod tests {
             (Param::TaubinMu, 0.5f32.to_bits()),
             (Param::SmoothGapM, f32::NEG_INFINITY.to_bits()),
             (Param::SplitGeometry, 3),
+            (Param::RoiXMinM, 2001.0f32.to_bits()),
+            (Param::OutputMode, 2),
         ];
         for (param, word) in cases {
             let mut w = good;
@@ -601,17 +608,63 @@ mod tests {
             );
         }
         let mut w = good;
-        w[10] = 1;
+        w[15] = 1;
         assert_eq!(
             KernelParams::from_words(&w),
-            Err(ParamsError::ReservedNotZero { index: 10 })
+            Err(ParamsError::ReservedNotZero { index: 15 })
         );
+        // A region must have positive extents; one bound alone is not a region.
         let mut w = good;
-        w[13] = 7;
+        w[Param::RoiXMaxM.word()] = 1.0f32.to_bits();
         assert_eq!(
             KernelParams::from_words(&w),
-            Err(ParamsError::ReservedNotZero { index: 13 })
+            Err(ParamsError::OutOfRange {
+                param: Param::RoiZMaxM
+            })
         );
+        w[Param::RoiXMinM.word()] = 1.0f32.to_bits();
+        assert_eq!(
+            KernelParams::from_words(&w),
+            Err(ParamsError::OutOfRange {
+                param: Param::RoiXMaxM
+            })
+        );
+    }
+
+    /// The region of interest: off when its four words are zero, else a box with positive
+    /// extents within ±2000 m; the words round-trip.
+    #[test]
+    fn region_of_interest_words() {
+        assert_eq!(KernelParams::DEFAULT.roi(), None);
+        let p = KernelParams {
+            roi_x_min_m: -15.0,
+            roi_x_max_m: 15.0,
+            roi_z_min_m: -4.0,
+            roi_z_max_m: -1.0,
+            output_mode: 1,
+            ..KernelParams::DEFAULT
+        };
+        assert_eq!(KernelParams::from_words(&p.to_words()), Ok(p));
+        let roi = p.roi().unwrap();
+        assert!(roi.contains(15.0, -1.0) && roi.contains(-15.0, -4.0));
+        assert!(!roi.contains(15.01, -2.0) && !roi.contains(0.0, -0.99));
+        assert!(!roi.contains(f32::NAN, -2.0));
+        assert_eq!(p.output_mode(), OutputMode::Candidates);
+        for (param, v) in [
+            (Param::RoiXMinM, -2000.5f32),
+            (Param::RoiXMaxM, 2000.5),
+            (Param::RoiXMaxM, -15.0),
+            (Param::RoiZMinM, f32::NAN),
+            (Param::RoiZMaxM, -4.0),
+        ] {
+            let mut w = p.to_words();
+            w[param.word()] = v.to_bits();
+            assert_eq!(
+                KernelParams::from_words(&w),
+                Err(ParamsError::OutOfRange { param }),
+                "{param:?} = {v}"
+            );
+        }
     }
 
     /// The messages a user reads: the field's name and its range.
@@ -656,10 +709,10 @@ mod tests {
             "split_geometry is outside its range 0..=2 (0 = auto, 1 = always, 2 = never)"
         );
         let mut w = KernelParams::DEFAULT.to_words();
-        w[12] = 0xff;
+        w[15] = 0xff;
         assert_eq!(
             KernelParams::from_words(&w).unwrap_err().to_string(),
-            "config word 12 is reserved and must be 0"
+            "config word 15 is reserved and must be 0"
         );
     }
 
@@ -702,6 +755,14 @@ mod tests {
                 Param::ALL.iter().position(|&p| p == param).unwrap()
             );
             let text = param.range();
+            // The region's bounds depend on each other: `region_of_interest_words` checks
+            // them.
+            if matches!(
+                param,
+                Param::RoiXMinM | Param::RoiXMaxM | Param::RoiZMinM | Param::RoiZMaxM
+            ) {
+                continue;
+            }
             if param.is_f32() {
                 let (lo_open, hi_open) = (text.starts_with('('), text.ends_with(')'));
                 let inner = &text[1..text.len() - 1];

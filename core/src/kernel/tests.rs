@@ -21,7 +21,7 @@ fn check_accounting(out: &ScanlineOutput<'_>) {
     let c = out.counters;
     assert_eq!(c.points_in as usize, out.status.len());
     assert_eq!(
-        c.kept + c.irregular + c.no_neighbour + c.non_finite,
+        c.kept + c.irregular + c.no_neighbour + c.non_finite + c.outside_roi,
         c.points_in
     );
     let count = |s: PointStatus| out.status.iter().filter(|&&x| x == s).count() as u32;
@@ -29,6 +29,7 @@ fn check_accounting(out: &ScanlineOutput<'_>) {
     assert_eq!(count(PointStatus::Irregular), c.irregular);
     assert_eq!(count(PointStatus::NoNeighbour), c.no_neighbour);
     assert_eq!(count(PointStatus::NonFinite), c.non_finite);
+    assert_eq!(count(PointStatus::OutsideRoi), c.outside_roi);
     for (i, (&s, &r)) in out.status.iter().zip(out.rho_deg).enumerate() {
         if s != PointStatus::Kept {
             assert_eq!(r, 0.0, "point {i} with status {s:?} has ρ");
@@ -721,4 +722,102 @@ fn huge_finite_coordinates_are_set_aside_and_every_output_stays_finite() {
             assert!(out.rho_deg[i].is_finite(), "rho at {i}");
         }
     }
+}
+
+/// With a region of interest, the points inside come first and get exactly what the kernel
+/// gives a line of those points alone, the points outside follow with their raw
+/// coordinates and tags, ρ = 0 and status OutsideRoi, and the candidates are the same.
+#[test]
+fn region_of_interest_is_the_kernel_on_the_points_inside() {
+    let scene = Scene::DEFAULT;
+    let roi = Roi {
+        x_min: -6.0,
+        x_max: 3.5,
+        z_min: -2.5,
+        z_max: -1.7,
+    };
+    let params = KernelParams {
+        roi_x_min_m: roi.x_min,
+        roi_x_max_m: roi.x_max,
+        roi_z_min_m: roi.z_min,
+        roi_z_max_m: roi.z_max,
+        ..KernelParams::DEFAULT
+    };
+    assert_eq!(params.validate(), Ok(()));
+    let mut checked_outside = 0;
+    for seed in 0..20u64 {
+        let mut buf = std::vec![(0f32, 0f32, 0u32); N];
+        let n = scene.generate(&mut Rng(seed), &mut buf);
+        let all = &buf[..n];
+        let inside: Vec<(f32, f32, u32)> = all
+            .iter()
+            .copied()
+            .filter(|&(x, z, _)| roi.contains(x, z))
+            .collect();
+        assert!(inside.len() < n && !inside.is_empty(), "seed {seed}");
+        let mut k_roi = Kernel::<N>::new(params);
+        let mut line = line_from(all);
+        let out = k_roi.process(&mut line);
+        check_accounting(&out);
+        assert_eq!(out.counters.outside_roi as usize, n - inside.len());
+        let mut k_sub = Kernel::<N>::new(KernelParams::DEFAULT);
+        let mut sub_line = line_from(&inside);
+        let sub = k_sub.process(&mut sub_line);
+        let m = inside.len();
+        assert_eq!(out.tag[..m], sub.tag[..]);
+        assert_eq!(out.status[..m], sub.status[..]);
+        for j in 0..m {
+            assert_eq!(out.x_m[j].to_bits(), sub.x_m[j].to_bits(), "x at {j}");
+            assert_eq!(out.z_m[j].to_bits(), sub.z_m[j].to_bits(), "z at {j}");
+            assert_eq!(out.rho_deg[j].to_bits(), sub.rho_deg[j].to_bits(), "ρ at {j}");
+        }
+        let mut outside: Vec<(u32, u32, u32)> = all
+            .iter()
+            .filter(|&&(x, z, _)| !roi.contains(x, z))
+            .map(|&(x, z, t)| (t, x.to_bits(), z.to_bits()))
+            .collect();
+        let mut got: Vec<(u32, u32, u32)> = (m..n)
+            .map(|i| (out.tag[i], out.x_m[i].to_bits(), out.z_m[i].to_bits()))
+            .collect();
+        outside.sort_unstable();
+        got.sort_unstable();
+        assert_eq!(got, outside);
+        assert!(out.status[m..].iter().all(|&s| s == PointStatus::OutsideRoi));
+        assert!(out.rho_deg[m..].iter().all(|&r| r == 0.0));
+        checked_outside += n - m;
+        assert_eq!(
+            (out.nadir, out.left, out.right),
+            (sub.nadir, sub.left, sub.right),
+            "seed {seed}"
+        );
+        let c = sub.counters;
+        assert_eq!(
+            (out.counters.kept, out.counters.irregular, out.counters.peaks),
+            (c.kept, c.irregular, c.peaks)
+        );
+    }
+    assert!(checked_outside > 100);
+}
+
+/// A region that holds every point changes nothing but the parameters' hash.
+#[test]
+fn a_region_holding_every_point_changes_nothing() {
+    let mut buf = std::vec![(0f32, 0f32, 0u32); N];
+    let n = Scene::DEFAULT.generate(&mut Rng(3), &mut buf);
+    let params = KernelParams {
+        roi_x_min_m: -100.0,
+        roi_x_max_m: 100.0,
+        roi_z_min_m: -100.0,
+        roi_z_max_m: 100.0,
+        ..KernelParams::DEFAULT
+    };
+    let mut a = Kernel::<N>::new(params);
+    let mut b = Kernel::<N>::new(KernelParams::DEFAULT);
+    let (mut la, mut lb) = (line_from(&buf[..n]), line_from(&buf[..n]));
+    let (oa, ob) = (a.process(&mut la), b.process(&mut lb));
+    assert_eq!(oa.counters, ob.counters);
+    assert_eq!((oa.nadir, oa.left, oa.right), (ob.nadir, ob.left, ob.right));
+    assert_eq!(oa.status, ob.status);
+    assert_eq!(oa.rho_deg, ob.rho_deg);
+    assert_ne!(oa.params_hash, ob.params_hash);
 }

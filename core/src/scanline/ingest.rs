@@ -384,7 +384,7 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
         let Some(kind) = kind else {
             return reject(self, |c| c.bad_kind += 1);
         };
-        if version < kind.min_version() {
+        if !(kind.min_version()..=kind.max_version()).contains(&version) {
             return reject(self, |c| c.bad_version += 1);
         }
         if !kind.length_ok(len) {
@@ -431,7 +431,7 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
                     let _ = self.ring.peek(HEADER_LEN + 4 * i, &mut b);
                     *w = u32::from_le_bytes(b);
                 }
-                if version < config_version(&words) {
+                if version != config_version(&words) {
                     return reject(self, |c| c.bad_version += 1);
                 }
                 self.ring.consume(len);
@@ -740,9 +740,9 @@ mod tests {
         let mut s = Vec::new();
         let n = enc.encode_points(0, &[pt(0, true)], &mut buf).unwrap();
         s.extend_from_slice(&buf[..n]);
-        // Version 2 with a valid CRC.
+        // Version 3 with a valid CRC.
         let mut v2 = buf[..n].to_vec();
-        v2[2] = 2;
+        v2[2] = 3;
         v2[8] = 1;
         let crc = crate::wire::crc::crc32(&v2[..n - 4]);
         v2[n - 4..].copy_from_slice(&crc.to_le_bytes());

@@ -353,6 +353,15 @@ impl PacketKind {
         }
     }
 
+    /// The last format version that has this kind in this form: a packet takes the lowest
+    /// version that expresses it (points packets are the same in both, so always 1).
+    pub const fn max_version(self) -> u8 {
+        match self {
+            Self::Points => VERSION_1,
+            _ => VERSION,
+        }
+    }
+
     /// The kind for byte `b`, if any.
     pub const fn from_u8(b: u8) -> Option<Self> {
         match b {
@@ -506,7 +515,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
         let kind = PacketKind::from_u8(self.kind_raw()).ok_or(Error::BadKind {
             kind: self.kind_raw(),
         })?;
-        if version < kind.min_version() {
+        if !(kind.min_version()..=kind.max_version()).contains(&version) {
             return Err(Error::BadVersion { version });
         }
         if !kind.length_ok(self.length()) {
@@ -628,7 +637,7 @@ impl ConfigRepr {
             *w = u32::from_le_bytes(get_bytes(chunk, 0));
         }
         let repr = Self { words };
-        if packet.version() < repr.version() {
+        if packet.version() != repr.version() {
             return Err(Error::BadVersion {
                 version: packet.version(),
             });
@@ -673,7 +682,7 @@ mod tests {
         g[..12].copy_from_slice(&[
             0xA5,
             0xC3,
-            0x01,
+            0x02, // version 2: words 10–15 are not zero
             0x02,
             CONFIG_PACKET_LEN as u8,
             0x00,
@@ -709,8 +718,8 @@ mod tests {
                 "packet does not start with the sync bytes A5 C3",
             ),
             (
-                Error::BadVersion { version: 2 },
-                "packet has format version 2, this code reads version 1",
+                Error::BadVersion { version: 3 },
+                "packet has format version 3, this code reads versions 1..=2 (version 2 for the fields it uses)",
             ),
             (
                 Error::BadKind { kind: 9 },
@@ -829,14 +838,23 @@ mod tests {
             ConfigRepr::parse(&Packet::new_unchecked(&b[..])),
             Err(Error::ReservedNotZero { offset: 6 })
         );
-        // Version 2 with a valid CRC.
+        // Version 3 with a valid CRC.
         let mut b = g;
-        b[2] = 2;
+        b[2] = 3;
         let crc = crc::crc32(&b[..CONFIG_PACKET_LEN - 4]);
         b[CONFIG_PACKET_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
         assert_eq!(
             ConfigRepr::parse(&Packet::new_unchecked(&b[..])),
-            Err(Error::BadVersion { version: 2 })
+            Err(Error::BadVersion { version: 3 })
+        );
+        // The golden words use version 2's words: labelled version 1 they are rejected.
+        let mut b = g;
+        b[2] = 1;
+        let crc = crc::crc32(&b[..CONFIG_PACKET_LEN - 4]);
+        b[CONFIG_PACKET_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
+        assert_eq!(
+            ConfigRepr::parse(&Packet::new_unchecked(&b[..])),
+            Err(Error::BadVersion { version: 1 })
         );
     }
 

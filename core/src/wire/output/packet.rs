@@ -2,7 +2,7 @@
 //! header and points, and writing one fragment point by point.
 
 use super::super::{
-    emit_header, field, get_u16, get_u32, get_u64, put_bytes, seal, EncodeError, Error, Packet,
+    emit_header, field, get_u16, get_u8, get_u32, get_u64, put_bytes, seal, EncodeError, Error, Packet,
     PacketKind, CRC_LEN, MAX_OUTPUT_POINTS_PER_PACKET, VERSION, VERSION_1,
 };
 use super::{output_packet_len, OutputPointRepr, NO_INDEX, OUTPUT_POINT_LEN};
@@ -92,6 +92,11 @@ impl OutputHeaderRepr {
             return Err(Error::ReservedNotZero {
                 offset: out::OUTSIDE.start,
             });
+        }
+        // One encoding per packet: an output packet takes the lowest version that carries
+        // it (a candidates packet is version 2 whatever its count).
+        if version > h.version() && get_u8(b, field::KIND) == PacketKind::Output as u8 {
+            return Err(Error::BadVersion { version });
         }
         if !h.indices_ok() {
             return Err(Error::OutOfRange {

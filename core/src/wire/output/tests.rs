@@ -42,6 +42,7 @@ fn header(line_len: u16) -> OutputHeaderRepr {
         irregular: 0,
         no_neighbour: 0,
         peaks: 1,
+        outside: 0,
     }
 }
 
@@ -395,6 +396,7 @@ proptest! {
             index, start_time_ns: t, params_hash: hash, truncated: trunc, line_len, first: 0,
             nadir: pick(nadir), left: pick(left), right: pick(nadir.wrapping_add(left)),
             kept: counts[0], irregular: counts[1], no_neighbour: counts[2], peaks: counts[3],
+            outside: counts[0] / 2,
         };
         let mut enc = StreamEncoder::new();
         let mut buf = vec![0u8; 8000];
