@@ -8,7 +8,9 @@
 # `name: value` per line, ending with `identical: yes` or
 # `identical: no (N of M scanlines differ)`. Exits 0 only when the libm firmware's output is
 # byte-identical to the host's and the micromath build agrees with it on the candidates of
-# at least 99 % of the scanlines. Progress goes to stderr, figures to stdout.
+# at least 99 % of the scanlines. Progress goes to stderr, figures to stdout. The stream's
+# config packet sets the output mode and the region of interest (`mode:` says which);
+# docs/benchmarks.md shows the runs for both modes.
 #
 # Needs Debian's rustc-web, cargo-web, rust-web-src, lld-19, qemu-system-arm (scripts/test.sh
 # installs them), gcc, binutils and rustup's stable cargo for the host side.
@@ -120,6 +122,11 @@ points=$(fig points_in "$WORK/fw-libm.txt")
 echo "stream: $(basename "$STREAM") ($(stat -c %s "$STREAM") bytes)"
 echo "points: $points"
 echo "scanlines: $(fig lines "$WORK/fw-libm.txt")"
+# The stream's config packet chooses the output mode (kind 3 output packets, or kind 4
+# candidates packets) and the region of interest: docs/wire-format.md, version 2.
+kind=$(od -An -tu1 -j3 -N1 "$WORK/out-libm.bin" 2> /dev/null | tr -d ' ')
+case "$kind" in 3) echo "mode: points";; 4) echo "mode: candidates";; *) echo "mode: none";; esac
+echo "outside_roi_points: $(fig outside_roi "$WORK/fw-libm.txt")"
 echo "flash_bytes: $flash (of 1048576)"
 echo "static_ram_bytes: $ram"
 echo "stack_reserved_bytes: $stack"
@@ -138,6 +145,9 @@ for name in libm micromath; do
     echo "insns_per_point_${name}_$s: $(per_point "$(stage $s "$c")" "$points")"
   done
   echo "insns_per_point_${name}_kernel_partition: $(per_point "$(stage kernel "$c")" "$points")"
+  # The kernel stages together: bend, smoothing, peaks and the partitions (region of
+  # interest, kept points).
+  echo "insns_per_point_${name}_kernel_stages: $(per_point $(($(stage bend "$c") + $(stage smoothing "$c") + $(stage peaks "$c") + $(stage kernel "$c"))) "$points")"
   echo "insns_per_point_${name}_output: $(per_point $(($(stage output "$c") + $(stage output+crc "$c"))) "$points")"
   echo "insns_per_point_${name}_output_crc_part: $(per_point "$(stage output+crc "$c")" "$points")"
   # The pipeline's per-line glue (Pipeline::run: events, config packets, counter sums)

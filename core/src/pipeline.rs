@@ -416,6 +416,50 @@ mod tests {
         );
     }
 
+    /// A version-2 config packet (region of interest, candidates mode) is applied: the points
+    /// outside are counted, the candidate is the same point as without a region, and each
+    /// line's output is one candidates packet whose records are `output_point`'s.
+    #[test]
+    fn region_and_candidates_mode_from_a_version_2_config() {
+        let params = KernelParams {
+            roi_x_min_m: -0.505,
+            roi_x_max_m: 2.0,
+            roi_z_min_m: -2.5,
+            roi_z_max_m: -1.5,
+            output_mode: 1,
+            ..KernelParams::DEFAULT
+        };
+        let mut enc = StreamEncoder::new();
+        let mut buf = [0u8; MAX_PACKET_LEN];
+        let n = enc.encode_config(&params.to_words(), &mut buf).unwrap();
+        assert_eq!(buf[2], 2, "a config with version-2 words is a version-2 packet");
+        let mut bytes = buf[..n].to_vec();
+        stream(&mut enc, 2, &mut bytes);
+        let mut p = std::boxed::Box::new(Pipeline::<RING, N>::new());
+        assert_eq!(p.write(&bytes), bytes.len());
+        let mut lines = 0;
+        p.finish(|o| {
+            lines += 1;
+            // Points at x′ < −0.5 (0..50) are outside; the toe (tag l·1000 + 200) is found.
+            assert_eq!(o.counters.outside_roi, 50);
+            assert_eq!(o.tag[usize::from(o.left.unwrap())] % 1000, 200);
+            let mut pk = std::vec![0u8; MAX_PACKET_LEN];
+            let len = encode_output(o, &mut StreamEncoder::new(), &mut pk).unwrap();
+            let c = CandidatesRepr::parse(&Packet::new_checked(&pk[..len]).unwrap()).unwrap();
+            assert_eq!(c.header.outside, 50);
+            assert_eq!(c.left, Some(output_point(o, usize::from(o.left.unwrap())).unwrap()));
+            assert_eq!(c.nadir.map(|r| r.tag), o.nadir.map(|i| o.tag[usize::from(i)]));
+        });
+        assert_eq!(lines, 2);
+        let c = p.counters();
+        assert_eq!((c.configs_applied, c.configs_rejected), (1, 0));
+        assert_eq!(c.outside_roi, 100);
+        assert_eq!(
+            c.kept + c.irregular + c.no_neighbour + c.non_finite + c.outside_roi,
+            600
+        );
+    }
+
     #[test]
     fn lines_flow_through_and_every_point_is_counted() {
         let mut enc = StreamEncoder::new();

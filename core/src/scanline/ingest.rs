@@ -12,7 +12,7 @@ use super::Line;
 use crate::wire::{
     scan_two, Error as WireError, GarbageReason, Packet, PacketKind, PointRecord, Scan,
     CONFIG_WORDS, HEADER_LEN, MAX_PACKET_LEN, POINTS_PREFIX_LEN, POINT_RECORD_LEN, VERSION,
-    VERSION_1, config_version,
+    VERSION_1, config_version, flags_version, FLAG_LINK_CHECKED,
 };
 
 /// What [`Ingest::poll`] produced.
@@ -384,13 +384,15 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
         let Some(kind) = kind else {
             return reject(self, |c| c.bad_kind += 1);
         };
-        if !(kind.min_version()..=kind.max_version()).contains(&version) {
+        let flags_v = flags_version(view.flags());
+        if !(kind.min_version().max(flags_v)..=kind.max_version().max(flags_v)).contains(&version)
+        {
             return reject(self, |c| c.bad_version += 1);
         }
         if !kind.length_ok(len) {
             return reject(self, |c| c.bad_kind_length += 1);
         }
-        if view.flags() != 0 {
+        if view.flags() & !FLAG_LINK_CHECKED != 0 {
             return reject(self, |c| c.reserved_flags += 1);
         }
         // Sequence numbers: a discontinuity may have swallowed a line boundary.
@@ -431,7 +433,7 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
                     let _ = self.ring.peek(HEADER_LEN + 4 * i, &mut b);
                     *w = u32::from_le_bytes(b);
                 }
-                if version != config_version(&words) {
+                if version != config_version(&words).max(flags_v) {
                     return reject(self, |c| c.bad_version += 1);
                 }
                 self.ring.consume(len);

@@ -12,17 +12,33 @@ use super::{
 #[derive(Clone, Debug, Default)]
 pub struct StreamEncoder {
     seq: u32,
+    link_checked: bool,
 }
 
 impl StreamEncoder {
     /// An encoder whose first packet has sequence number 0.
     pub const fn new() -> Self {
-        Self { seq: 0 }
+        Self {
+            seq: 0,
+            link_checked: false,
+        }
+    }
+
+    /// This encoder, writing every packet as [`super::FLAG_LINK_CHECKED`] (version 2, CRC
+    /// field zero) when `on`: for a link that checks integrity itself.
+    pub const fn link_checked(self, on: bool) -> Self {
+        Self {
+            link_checked: on,
+            ..self
+        }
     }
 
     /// An encoder whose first packet has sequence number `seq`.
     pub const fn with_seq(seq: u32) -> Self {
-        Self { seq }
+        Self {
+            seq,
+            link_checked: false,
+        }
     }
 
     /// The sequence number the next packet will carry.
@@ -30,9 +46,12 @@ impl StreamEncoder {
         self.seq
     }
 
-    fn bump(&mut self, r: Result<usize, EncodeError>) -> Result<usize, EncodeError> {
+    fn bump(&mut self, r: Result<usize, EncodeError>, out: &mut [u8]) -> Result<usize, EncodeError> {
         if r.is_ok() {
             self.seq = self.seq.wrapping_add(1);
+            if self.link_checked {
+                super::mark_link_checked(out);
+            }
         }
         r
     }
@@ -45,7 +64,7 @@ impl StreamEncoder {
         out: &mut [u8],
     ) -> Result<usize, EncodeError> {
         let r = ConfigRepr { words: *words }.emit(self.seq, out);
-        self.bump(r)
+        self.bump(r, out)
     }
 
     /// Writes a candidates packet (version 2): one line's nadir and seed candidates.
@@ -56,7 +75,7 @@ impl StreamEncoder {
         out: &mut [u8],
     ) -> Result<usize, EncodeError> {
         let r = repr.emit(self.seq, out);
-        self.bump(r)
+        self.bump(r, out)
     }
 
     /// Writes a points packet: `points` (at most [`super::MAX_POINTS_PER_PACKET`]) with times
@@ -69,7 +88,7 @@ impl StreamEncoder {
         out: &mut [u8],
     ) -> Result<usize, EncodeError> {
         let r = emit_points(self.seq, base_time_ns, points, out);
-        self.bump(r)
+        self.bump(r, out)
     }
 
     /// Writes one output packet: `header` describes the line and `header.first` is the index
@@ -98,7 +117,7 @@ impl StreamEncoder {
                 .ok_or(EncodeError::OutOfRange { index: i })
         };
         let r = emit_output_fragment(self.seq, header, header.first, &mut get, out);
-        self.bump(r)
+        self.bump(r, out)
     }
 
     /// Writes the output packet of `header`'s line that starts at point `first` (0, then
@@ -114,7 +133,7 @@ impl StreamEncoder {
         out: &mut [u8],
     ) -> Result<usize, EncodeError> {
         let r = emit_output_fragment(self.seq, header, first, &mut point, out);
-        self.bump(r)
+        self.bump(r, out)
     }
 
     /// [`Self::encode_output_fragment`] for a line held as columns (the kernel's structure
@@ -142,7 +161,7 @@ impl StreamEncoder {
             &mut point,
             out,
         );
-        self.bump(r)
+        self.bump(r, out)
     }
 
     /// Writes all [`OutputHeaderRepr::fragments`] packets of `header`'s line back to back

@@ -67,6 +67,10 @@ pub const SYNC: [u8; 2] = [0xA5, 0xC3];
 pub const VERSION: u8 = 2;
 /// The first version, still read.
 pub const VERSION_1: u8 = 1;
+/// Header flag (version 2): the packet travels on a link that checks its integrity itself
+/// (e.g. SPI with its hardware CRC, from the scanner's front end), so its CRC field is zero
+/// and not computed. Any other flag bit is reserved.
+pub const FLAG_LINK_CHECKED: u16 = 1;
 /// Config words a version-1 config packet may set (the rest must be zero in version 1).
 pub const CONFIG_WORDS_V1: usize = 10;
 /// Length of the common header in bytes.
@@ -499,14 +503,23 @@ impl<T: AsRef<[u8]>> Packet<T> {
         Ok(())
     }
 
-    /// Full validation of the envelope: [`Packet::check_len`], CRC, version, known kind,
-    /// length valid for the kind and zero reserved flags. Returns the kind.
+    /// Full validation of the envelope: [`Packet::check_len`], CRC (or, for a
+    /// [`FLAG_LINK_CHECKED`] packet, a zero CRC field), version, known kind, length valid
+    /// for the kind and zero reserved flags. Returns the kind.
     pub fn check(&self) -> Result<PacketKind, Error> {
         self.check_len()?;
-        let computed = self.compute_crc();
         let stored = self.crc();
-        if computed != stored {
-            return Err(Error::Crc { stored, computed });
+        if self.link_checked() {
+            if stored != 0 {
+                return Err(Error::ReservedNotZero {
+                    offset: self.length() - CRC_LEN,
+                });
+            }
+        } else {
+            let computed = self.compute_crc();
+            if computed != stored {
+                return Err(Error::Crc { stored, computed });
+            }
         }
         let version = self.version();
         if !(VERSION_1..=VERSION).contains(&version) {
@@ -515,7 +528,9 @@ impl<T: AsRef<[u8]>> Packet<T> {
         let kind = PacketKind::from_u8(self.kind_raw()).ok_or(Error::BadKind {
             kind: self.kind_raw(),
         })?;
-        if !(kind.min_version()..=kind.max_version()).contains(&version) {
+        let flags_v = flags_version(self.flags());
+        if !(kind.min_version().max(flags_v)..=kind.max_version().max(flags_v)).contains(&version)
+        {
             return Err(Error::BadVersion { version });
         }
         if !kind.length_ok(self.length()) {
@@ -523,12 +538,18 @@ impl<T: AsRef<[u8]>> Packet<T> {
                 length: self.length(),
             });
         }
-        if self.flags() != 0 {
+        if self.flags() & !FLAG_LINK_CHECKED != 0 {
             return Err(Error::ReservedNotZero {
                 offset: field::FLAGS.start,
             });
         }
         Ok(kind)
+    }
+
+    /// Whether the packet is a version-2 packet flagged [`FLAG_LINK_CHECKED`] (its CRC is
+    /// not computed).
+    pub fn link_checked(&self) -> bool {
+        self.version() == VERSION && self.flags() & FLAG_LINK_CHECKED != 0
     }
 
     /// The inner buffer.
@@ -606,6 +627,26 @@ impl<T: AsRef<[u8]>> Packet<T> {
     }
 }
 
+/// The lowest format version that carries header flags `flags` (2 for
+/// [`FLAG_LINK_CHECKED`]).
+pub const fn flags_version(flags: u16) -> u8 {
+    if flags & FLAG_LINK_CHECKED != 0 {
+        VERSION
+    } else {
+        VERSION_1
+    }
+}
+
+/// Marks the packet at the start of `packet` (its length field delimits it) as
+/// [`FLAG_LINK_CHECKED`]: version 2, the flag set, the CRC field zero. For a sender whose
+/// link checks integrity itself.
+pub fn mark_link_checked(packet: &mut [u8]) {
+    let length = usize::from(get_u16(packet, field::LENGTH));
+    put_bytes(packet, field::VERSION, &[VERSION]);
+    put_bytes(packet, field::FLAGS.start, &FLAG_LINK_CHECKED.to_le_bytes());
+    put_bytes(packet, length.saturating_sub(CRC_LEN), &[0; CRC_LEN]);
+}
+
 /// The lowest format version whose config packet carries `words` (see
 /// [`ConfigRepr::version`]).
 pub fn config_version(words: &[u32; CONFIG_WORDS]) -> u8 {
@@ -637,7 +678,7 @@ impl ConfigRepr {
             *w = u32::from_le_bytes(get_bytes(chunk, 0));
         }
         let repr = Self { words };
-        if packet.version() != repr.version() {
+        if packet.version() != repr.version().max(flags_version(packet.flags())) {
             return Err(Error::BadVersion {
                 version: packet.version(),
             });
@@ -831,7 +872,7 @@ mod tests {
         ));
         // Valid CRC but a reserved flag set: rejected (canonical format).
         let mut b = g;
-        b[6] = 1;
+        b[6] = 2;
         let crc = crc::crc32(&b[..CONFIG_PACKET_LEN - 4]);
         b[CONFIG_PACKET_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
         assert_eq!(

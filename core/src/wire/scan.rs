@@ -10,7 +10,10 @@
 //! false sync inside garbage (or inside a corrupted packet) is still found.
 
 use super::crc::Crc32;
-use super::{field, CRC_LEN, HEADER_LEN, MAX_PACKET_LEN, MIN_PACKET_LEN, SYNC};
+use super::{
+    field, PacketKind, CRC_LEN, FLAG_LINK_CHECKED, HEADER_LEN, MAX_PACKET_LEN, MIN_PACKET_LEN, SYNC,
+    VERSION,
+};
 
 /// What the start of the unread bytes holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -169,6 +172,21 @@ pub fn scan_two(a: &[u8], b: &[u8], at_end: bool) -> Scan {
     let mut stored = [0u8; CRC_LEN];
     if !copy_from_two(a, b, length - CRC_LEN, &mut stored) {
         return wait_or_skip();
+    }
+    // A link-checked packet (version 2, flag set, CRC field zero) carries no CRC: the link
+    // below checked it. It must then at least name a known kind of a fitting length, or a
+    // false sync would make the reader skip a whole false length of real packets.
+    let mut hdr = [0u8; HEADER_LEN];
+    let _ = copy_from_two(a, b, 0, &mut hdr);
+    let flags = u16::from_le_bytes([hdr[field::FLAGS.start], hdr[field::FLAGS.start + 1]]);
+    if hdr[field::VERSION] == VERSION && flags == FLAG_LINK_CHECKED && stored == [0; CRC_LEN] {
+        return match PacketKind::from_u8(hdr[field::KIND]) {
+            Some(kind) if kind.length_ok(length) => Scan::Packet { len: length },
+            _ => Scan::Garbage {
+                len: 1,
+                reason: GarbageReason::BadLength,
+            },
+        };
     }
     if crc_two(a, b, length - CRC_LEN) != u32::from_le_bytes(stored) {
         return Scan::Garbage {

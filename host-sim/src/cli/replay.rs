@@ -28,6 +28,10 @@ pub struct Args {
     /// TOML config (kernel parameters go into the config packet).
     #[arg(long)]
     pub config: Option<PathBuf>,
+    /// Write every packet link-checked (wire format version 2: no CRC, for a link that
+    /// checks integrity itself, such as the scanner front end's SPI with its hardware CRC).
+    #[arg(long)]
+    pub link_checked: bool,
 }
 
 /// Runs `curbtrace replay`.
@@ -59,7 +63,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         run::encode_stream(&cols, rg, &traj, &words, &rule, &mut |b: &[u8]| {
             packets += 1;
             bytes += b.len() as u64;
-            w.write_all(b)?;
+            if args.link_checked {
+                let mut p = b.to_vec();
+                curbtrace_core::wire::mark_link_checked(&mut p);
+                w.write_all(&p)?;
+            } else {
+                w.write_all(b)?;
+            }
             Ok(())
         })
         .with_context(|| format!("{}: writing the stream", args.output.display()))?;

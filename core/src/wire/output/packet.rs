@@ -3,7 +3,7 @@
 
 use super::super::{
     emit_header, field, get_u16, get_u8, get_u32, get_u64, put_bytes, seal, EncodeError, Error, Packet,
-    PacketKind, CRC_LEN, MAX_OUTPUT_POINTS_PER_PACKET, VERSION, VERSION_1,
+    PacketKind, CRC_LEN, MAX_OUTPUT_POINTS_PER_PACKET, VERSION, VERSION_1, flags_version,
 };
 use super::{output_packet_len, OutputPointRepr, NO_INDEX, OUTPUT_POINT_LEN};
 
@@ -95,7 +95,8 @@ impl OutputHeaderRepr {
         }
         // One encoding per packet: an output packet takes the lowest version that carries
         // it (a candidates packet is version 2 whatever its count).
-        if version > h.version() && get_u8(b, field::KIND) == PacketKind::Output as u8 {
+        let need = h.version().max(flags_version(get_u16(b, field::FLAGS)));
+        if version > need && get_u8(b, field::KIND) == PacketKind::Output as u8 {
             return Err(Error::BadVersion { version });
         }
         if !h.indices_ok() {

@@ -435,3 +435,139 @@ proptest! {
         }
     }
 }
+
+/// A candidates packet: version 2, 104 bytes, parse ∘ emit is the identity, an absent
+/// record is 16 zero bytes, and the packet labelled version 1 is refused.
+#[test]
+fn candidates_packet_round_trips_as_version_2() {
+    use crate::wire::{CandidatesRepr, PacketKind, CANDIDATES_PACKET_LEN};
+    let p = |tag: u32, x: f32| OutputPointRepr::from_f32(tag, x, -2.0, 91.5, 0, 0).unwrap();
+    let header = OutputHeaderRepr {
+        nadir: Some(3),
+        left: Some(7),
+        right: None,
+        outside: 1200,
+        ..header(10)
+    };
+    let c = CandidatesRepr {
+        header,
+        nadir: Some(p(3, 0.01)),
+        left: Some(p(7, 2.4)),
+        right: None,
+    };
+    let mut buf = [0u8; 200];
+    let n = StreamEncoder::with_seq(5)
+        .encode_candidates(&c, &mut buf)
+        .unwrap();
+    assert_eq!((n, CANDIDATES_PACKET_LEN), (104, 104));
+    let pk = Packet::new_checked(&buf[..n]).unwrap();
+    assert_eq!((pk.version(), pk.kind()), (2, Some(PacketKind::Candidates)));
+    assert_eq!(CandidatesRepr::parse(&pk), Ok(c));
+    assert!(buf[n - 4 - 16..n - 4].iter().all(|&b| b == 0));
+    // A record without its index, or an index without its record, is refused.
+    let bad = CandidatesRepr { right: c.left, ..c };
+    assert!(StreamEncoder::new().encode_candidates(&bad, &mut buf).is_err());
+    let bad = CandidatesRepr { left: None, ..c };
+    assert!(StreamEncoder::new().encode_candidates(&bad, &mut buf).is_err());
+    // Relabelled version 1 (CRC fixed): version 1 has no candidates packet.
+    let mut v1 = buf[..n].to_vec();
+    v1[2] = 1;
+    let crc = crate::wire::crc::crc32(&v1[..n - 4]);
+    v1[n - 4..].copy_from_slice(&crc.to_le_bytes());
+    assert_eq!(
+        CandidatesRepr::parse(&Packet::new_checked(&v1[..]).unwrap()),
+        Err(crate::wire::Error::BadVersion { version: 1 })
+    );
+}
+
+/// An output packet takes version 2 exactly when it counts points outside the region of
+/// interest; a version-1 reader's packets (count 0) are unchanged.
+#[test]
+fn output_packets_take_version_2_only_for_the_outside_count() {
+    let relabel = |b: &[u8], v: u8| {
+        let mut b = b.to_vec();
+        let n = b.len();
+        b[2] = v;
+        let crc = crate::wire::crc::crc32(&b[..n - 4]);
+        b[n - 4..].copy_from_slice(&crc.to_le_bytes());
+        b
+    };
+    let pt = OutputPointRepr::from_f32(1, 0.5, -2.0, 0.0, 4, 0).unwrap();
+    let mut buf = [0u8; 200];
+    for (outside, version) in [(0u16, 1u8), (9, 2)] {
+        let h = OutputHeaderRepr {
+            outside,
+            ..header(1)
+        };
+        let n = StreamEncoder::new().encode_output(&h, &[pt], &mut buf).unwrap();
+        let pk = Packet::new_checked(&buf[..n]).unwrap();
+        assert_eq!(pk.version(), version);
+        let (got, _) = OutputHeaderRepr::parse(&pk).unwrap();
+        assert_eq!(got, h);
+        let other = relabel(&buf[..n], 3 - version);
+        let err = OutputHeaderRepr::parse(&Packet::new_checked(&other[..]).unwrap()).unwrap_err();
+        if version == 2 {
+            assert_eq!(err, crate::wire::Error::ReservedNotZero { offset: 50 });
+        } else {
+            assert_eq!(err, crate::wire::Error::BadVersion { version: 2 });
+        }
+    }
+}
+
+/// Link-checked packets (version 2, flag 1, CRC field zero) of every kind are read without
+/// a CRC, by `Packet::check`, the scanner and ingest; a non-zero CRC field, a version-1
+/// label or another flag bit is refused.
+#[test]
+fn link_checked_packets_are_read_without_a_crc() {
+    use crate::scanline::Ingest;
+    use crate::wire::{
+        mark_link_checked, scan, ConfigRepr, PointRecord, PointsRepr, Scan, FLAG_LINK_CHECKED,
+        MAX_PACKET_LEN,
+    };
+    let mut enc = StreamEncoder::new().link_checked(true);
+    let mut buf = [0u8; MAX_PACKET_LEN];
+    let mut stream = Vec::new();
+    let n = enc.encode_config(&[0; 16], &mut buf).unwrap();
+    assert_eq!(ConfigRepr::parse(&Packet::new_checked(&buf[..n]).unwrap()).unwrap().words, [0; 16]);
+    let pts: Vec<PointRecord> = (0..40)
+        .map(|i| PointRecord {
+            dt_ns: 1000 * i,
+            x_m: -0.2 + 0.01 * i as f32,
+            z_m: -2.0,
+            intensity: 0,
+            line_start: i == 0,
+            tag: i,
+        })
+        .collect();
+    let n = enc.encode_points(5, &pts, &mut buf).unwrap();
+    let pk = Packet::new_checked(&buf[..n]).unwrap();
+    assert_eq!((pk.version(), pk.flags(), pk.crc()), (2, FLAG_LINK_CHECKED, 0));
+    assert!(pk.link_checked());
+    assert_eq!(PointsRepr::parse(&pk).unwrap().points.len(), 40);
+    assert_eq!(scan(&buf[..n], true), Scan::Packet { len: n });
+    stream.extend_from_slice(&buf[..n]);
+    // The same packet with a CRC in its field, or labelled version 1, is refused.
+    let mut bad = buf[..n].to_vec();
+    bad[n - 1] = 1;
+    assert!(PointsRepr::parse(&Packet::new_checked(&bad[..]).unwrap()).is_err());
+    assert!(matches!(scan(&bad, true), Scan::Garbage { .. }));
+    let mut v1 = buf[..n].to_vec();
+    v1[2] = 1;
+    assert!(PointsRepr::parse(&Packet::new_checked(&v1[..]).unwrap()).is_err());
+    // Marking a packet written with a CRC gives the encoder's bytes.
+    let mut plain = [0u8; MAX_PACKET_LEN];
+    let m = StreamEncoder::with_seq(1).encode_points(5, &pts, &mut plain).unwrap();
+    mark_link_checked(&mut plain[..m]);
+    assert_eq!(plain[..m], buf[..n]);
+    let mut ing = Ingest::<4096, 64>::new();
+    assert_eq!(ing.write(&stream), stream.len());
+    ing.finish();
+    let mut points = 0;
+    while let Some(ev) = ing.poll() {
+        if let crate::scanline::IngestEvent::Line(l) = ev {
+            points += l.len();
+        }
+    }
+    let c = ing.counters();
+    assert_eq!((points, c.crc_errors, c.bad_version, c.reserved_flags), (40, 0, 0, 0));
+}
