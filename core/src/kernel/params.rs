@@ -315,10 +315,11 @@ pub struct Roi {
 }
 
 impl Roi {
-    /// Whether (x′, z′) lies in the box (bounds included; NaN never does).
+    /// Whether (x′, z′) lies in the box (bounds included; NaN never does). The upper z′
+    /// bound is tested first: most points outside a ground band lie above it (walls, trees).
     #[inline(always)]
     pub fn contains(&self, x: f32, z: f32) -> bool {
-        x >= self.x_min && x <= self.x_max && z >= self.z_min && z <= self.z_max
+        z <= self.z_max && z >= self.z_min && x >= self.x_min && x <= self.x_max
     }
 }
 
