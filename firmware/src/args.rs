@@ -2,7 +2,8 @@
 //! `-semihosting-config …,arg=fw,arg=IN,arg=OUT` as `"fw IN OUT"`).
 //!
 //! `fw [IN [OUT]]` processes IN (default `stream.bin`) into OUT (default `results.bin`);
-//! `fw --usart=BYTES` processes a stream of BYTES bytes arriving on USART3 into packets sent
+//! `fw --realtime=BYTES_PER_S IN OUT` processes IN delivered by a timer interrupt at that
+//! rate (the real-time run under QEMU's `-icount`); `fw --usart=BYTES` processes a stream of BYTES bytes arriving on USART3 into packets sent
 //! on USART6 (QEMU's `-serial` chardevs); `fw --selftest=overflow|hardfault|panic` provokes
 //! that failure, to check that each one ends the run with a non-zero exit instead of a hang
 //! or a silent success.
@@ -23,6 +24,16 @@ pub enum Command<'a> {
     Usart {
         /// The stream's length: the run ends once this many bytes have arrived.
         bytes: u64,
+    },
+    /// Process `input` into `output` with the stream delivered by a timer interrupt at
+    /// `bytes_per_s` bytes per second of the board's time (`fw --realtime=BYTES_PER_S IN OUT`).
+    Realtime {
+        /// Delivery rate, bytes per second.
+        bytes_per_s: u32,
+        /// The input stream's host path.
+        input: &'a CStr,
+        /// The output file's host path.
+        output: &'a CStr,
     },
     /// Overflow the stack (it must fault: the stack lies below the statics).
     SelfTestOverflow,
@@ -64,7 +75,23 @@ pub fn parse(buf: &mut [u8], len: usize) -> Result<Command<'_>, ArgsError> {
         .filter_map(|w| CStr::from_bytes_with_nul(w).ok());
     let first = words.next();
     let second = words.next();
-    if words.next().is_some() {
+    let third = words.next();
+    if let Some(rate) = first.and_then(|w| w.to_bytes().strip_prefix(b"--realtime=")) {
+        let bytes_per_s = core::str::from_utf8(rate)
+            .ok()
+            .and_then(|c| c.parse().ok())
+            .filter(|&r: &u32| r > 0)
+            .ok_or(ArgsError::BadByteCount)?;
+        if words.next().is_some() {
+            return Err(ArgsError::TooManyArguments);
+        }
+        return Ok(Command::Realtime {
+            bytes_per_s,
+            input: second.unwrap_or(c"stream.bin"),
+            output: third.unwrap_or(c"results.bin"),
+        });
+    }
+    if third.is_some() {
         return Err(ArgsError::TooManyArguments);
     }
     if let Some(opt) = first.filter(|w| w.to_bytes().starts_with(b"--")) {
@@ -143,6 +170,19 @@ mod tests {
         assert_eq!(parse_str("fw --usart=-1"), Err(ArgsError::BadByteCount));
         assert_eq!(parse_str("fw --usart"), Err(ArgsError::UnknownOption));
         assert_eq!(parse_str("fw a b c"), Err(ArgsError::TooManyArguments));
+        assert_eq!(
+            parse_str("fw --realtime=4075000 in.bin out.bin"),
+            Ok(Command::Realtime {
+                bytes_per_s: 4_075_000,
+                input: c"in.bin",
+                output: c"out.bin"
+            })
+        );
+        assert_eq!(parse_str("fw --realtime=0 a b"), Err(ArgsError::BadByteCount));
+        assert_eq!(
+            parse_str("fw --realtime=9 a b c"),
+            Err(ArgsError::TooManyArguments)
+        );
     }
 
     #[test]

@@ -8,6 +8,8 @@ mod stack;
 
 #[cfg(not(feature = "board"))]
 mod qemu;
+#[cfg(not(any(feature = "usart", feature = "board")))]
+mod realtime;
 #[cfg(not(feature = "board"))]
 mod semihosting_io;
 

@@ -62,6 +62,11 @@ fn main() -> ! {
     let (input_name, output_name) = match args::parse(&mut cmdline, len) {
         Ok(Command::Process { input, output }) => (input, output),
         Ok(Command::Usart { bytes }) => over_usarts(bytes),
+        Ok(Command::Realtime {
+            bytes_per_s,
+            input,
+            output,
+        }) => realtime_run(bytes_per_s, input, output),
         Ok(Command::SelfTestOverflow) => {
             let mut seed = [0u8; 64];
             figure!("never_printed", selftest::overflow(&mut seed, u32::MAX));
@@ -114,6 +119,57 @@ fn over_files(input_name: &CStr, output_name: &CStr) -> ! {
     debug::exit(EXIT_SUCCESS);
     // Unreachable under QEMU; on a board without a debugger, stop here.
     cortex_m::asm::udf()
+}
+
+/// `--realtime=BYTES_PER_S IN OUT`: `over_files` with the input delivered by a timer
+/// interrupt at that rate (`realtime.rs`); the figures add the delivery's.
+#[cfg(not(any(feature = "usart", feature = "board")))]
+#[inline(never)]
+fn realtime_run(bytes_per_s: u32, input_name: &CStr, output_name: &CStr) -> ! {
+    use crate::realtime;
+    let (Ok(file), Ok(mut output)) = (
+        HostFile::open(input_name, Mode::ReadBinary),
+        HostFile::open(output_name, Mode::WriteBinary),
+    ) else {
+        fail!("cannot open {:?} or {:?}", input_name, output_name);
+        exit_failure()
+    };
+    let Some(p) = cortex_m::Peripherals::take() else {
+        fail!("core peripherals already taken");
+        exit_failure()
+    };
+    let (node, packet) = working_memory();
+    let stack_init = stack::repaint();
+    let Some(mut input) = realtime::start(p.SYST, file, bytes_per_s) else {
+        fail!("the delivery queue is already in use");
+        exit_failure()
+    };
+    let summary = match app::run(node, &mut input, &mut output, packet) {
+        Ok(s) => s,
+        Err(e) => {
+            fail!("processing failed: {:?}", e);
+            exit_failure()
+        }
+    };
+    figures(&summary, stack_init);
+    let f = realtime::figures();
+    figure!("realtime_bytes_per_s", bytes_per_s);
+    figure!("realtime_tick_hz", realtime::TICK_HZ);
+    figure!("realtime_ticks", f.ticks);
+    figure!("realtime_delivered_bytes", f.delivered);
+    figure!("realtime_dropped_bytes", f.dropped);
+    figure!("realtime_queue_bytes", realtime::QUEUE);
+    figure!("realtime_queue_high_water_bytes", f.high_water);
+    drop(output);
+    debug::exit(EXIT_SUCCESS);
+    cortex_m::asm::udf()
+}
+
+/// `--realtime` needs SysTick, which the USART and board builds use for their clock.
+#[cfg(any(feature = "usart", feature = "board"))]
+fn realtime_run(_: u32, _: &CStr, _: &CStr) -> ! {
+    fail!("--realtime is in the plain QEMU build only (no `usart` feature)");
+    exit_failure()
 }
 
 /// All the core's working memory, a `static` built by the core's `const fn` `Pipeline::new`
