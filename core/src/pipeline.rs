@@ -34,13 +34,10 @@
 //! assert_eq!(p.counters().kernel_points, 50);
 //! ```
 
-use crate::kernel::{
-    Kernel, KernelParams, OutputMode, ParamsError, PointStatus, ScanlineOutput,
-};
+use crate::kernel::{Kernel, KernelParams, OutputMode, ParamsError, PointStatus, ScanlineOutput};
 use crate::scanline::{Ingest, IngestCounters, IngestEvent};
 use crate::wire::{
-    CandidatesRepr, EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr,
-    StreamEncoder,
+    CandidatesRepr, EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr, StreamEncoder,
 };
 
 /// Everything the pipeline counted: ingest's counters plus the kernel's, summed over lines,
@@ -432,7 +429,10 @@ mod tests {
         let mut enc = StreamEncoder::new();
         let mut buf = [0u8; MAX_PACKET_LEN];
         let n = enc.encode_config(&params.to_words(), &mut buf).unwrap();
-        assert_eq!(buf[2], 2, "a config with version-2 words is a version-2 packet");
+        assert_eq!(
+            buf[2], 2,
+            "a config with version-2 words is a version-2 packet"
+        );
         let mut bytes = buf[..n].to_vec();
         stream(&mut enc, 2, &mut bytes);
         let mut p = std::boxed::Box::new(Pipeline::<RING, N>::new());
@@ -447,8 +447,14 @@ mod tests {
             let len = encode_output(o, &mut StreamEncoder::new(), &mut pk).unwrap();
             let c = CandidatesRepr::parse(&Packet::new_checked(&pk[..len]).unwrap()).unwrap();
             assert_eq!(c.header.outside, 50);
-            assert_eq!(c.left, Some(output_point(o, usize::from(o.left.unwrap())).unwrap()));
-            assert_eq!(c.nadir.map(|r| r.tag), o.nadir.map(|i| o.tag[usize::from(i)]));
+            assert_eq!(
+                c.left,
+                Some(output_point(o, usize::from(o.left.unwrap())).unwrap())
+            );
+            assert_eq!(
+                c.nadir.map(|r| r.tag),
+                o.nadir.map(|i| o.tag[usize::from(i)])
+            );
         });
         assert_eq!(lines, 2);
         let c = p.counters();

@@ -178,7 +178,10 @@ mod tests {
                 output: c"out.bin"
             })
         );
-        assert_eq!(parse_str("fw --realtime=0 a b"), Err(ArgsError::BadByteCount));
+        assert_eq!(
+            parse_str("fw --realtime=0 a b"),
+            Err(ArgsError::BadByteCount)
+        );
         assert_eq!(
             parse_str("fw --realtime=9 a b c"),
             Err(ArgsError::TooManyArguments)

@@ -769,7 +769,11 @@ fn region_of_interest_is_the_kernel_on_the_points_inside() {
         for j in 0..m {
             assert_eq!(out.x_m[j].to_bits(), sub.x_m[j].to_bits(), "x at {j}");
             assert_eq!(out.z_m[j].to_bits(), sub.z_m[j].to_bits(), "z at {j}");
-            assert_eq!(out.rho_deg[j].to_bits(), sub.rho_deg[j].to_bits(), "ρ at {j}");
+            assert_eq!(
+                out.rho_deg[j].to_bits(),
+                sub.rho_deg[j].to_bits(),
+                "ρ at {j}"
+            );
         }
         let mut outside: Vec<(u32, u32, u32)> = all
             .iter()
@@ -782,7 +786,9 @@ fn region_of_interest_is_the_kernel_on_the_points_inside() {
         outside.sort_unstable();
         got.sort_unstable();
         assert_eq!(got, outside);
-        assert!(out.status[m..].iter().all(|&s| s == PointStatus::OutsideRoi));
+        assert!(out.status[m..]
+            .iter()
+            .all(|&s| s == PointStatus::OutsideRoi));
         assert!(out.rho_deg[m..].iter().all(|&r| r == 0.0));
         checked_outside += n - m;
         assert_eq!(
@@ -792,7 +798,11 @@ fn region_of_interest_is_the_kernel_on_the_points_inside() {
         );
         let c = sub.counters;
         assert_eq!(
-            (out.counters.kept, out.counters.irregular, out.counters.peaks),
+            (
+                out.counters.kept,
+                out.counters.irregular,
+                out.counters.peaks
+            ),
             (c.kept, c.irregular, c.peaks)
         );
     }

@@ -10,9 +10,9 @@ use super::assemble::{AssembleCounters, Assembler, Offer, SplitParams, SplitReas
 use super::ring::Ring;
 use super::Line;
 use crate::wire::{
-    scan_two, Error as WireError, GarbageReason, Packet, PacketKind, PointRecord, Scan,
-    CONFIG_WORDS, HEADER_LEN, MAX_PACKET_LEN, POINTS_PREFIX_LEN, POINT_RECORD_LEN, VERSION,
-    VERSION_1, config_version, flags_version, FLAG_LINK_CHECKED,
+    config_version, flags_version, scan_two, Error as WireError, GarbageReason, Packet, PacketKind,
+    PointRecord, Scan, CONFIG_WORDS, FLAG_LINK_CHECKED, HEADER_LEN, MAX_PACKET_LEN,
+    POINTS_PREFIX_LEN, POINT_RECORD_LEN, VERSION, VERSION_1,
 };
 
 /// What [`Ingest::poll`] produced.
@@ -385,8 +385,7 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
             return reject(self, |c| c.bad_kind += 1);
         };
         let flags_v = flags_version(view.flags());
-        if !(kind.min_version().max(flags_v)..=kind.max_version().max(flags_v)).contains(&version)
-        {
+        if !(kind.min_version().max(flags_v)..=kind.max_version().max(flags_v)).contains(&version) {
             return reject(self, |c| c.bad_version += 1);
         }
         if !kind.length_ok(len) {

@@ -3,8 +3,8 @@
 use super::output::{emit_output_fragment, emit_output_fragment_columns};
 use super::points::emit_points;
 use super::{
-    CandidatesRepr, ConfigRepr, EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr, PointRecord,
-    CONFIG_WORDS, MAX_OUTPUT_POINTS_PER_PACKET,
+    CandidatesRepr, ConfigRepr, EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr,
+    PointRecord, CONFIG_WORDS, MAX_OUTPUT_POINTS_PER_PACKET,
 };
 
 /// Encodes packets of one stream. Every successfully written packet takes the next sequence
@@ -46,7 +46,11 @@ impl StreamEncoder {
         self.seq
     }
 
-    fn bump(&mut self, r: Result<usize, EncodeError>, out: &mut [u8]) -> Result<usize, EncodeError> {
+    fn bump(
+        &mut self,
+        r: Result<usize, EncodeError>,
+        out: &mut [u8],
+    ) -> Result<usize, EncodeError> {
         if r.is_ok() {
             self.seq = self.seq.wrapping_add(1);
             if self.link_checked {

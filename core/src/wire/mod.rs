@@ -529,8 +529,7 @@ impl<T: AsRef<[u8]>> Packet<T> {
             kind: self.kind_raw(),
         })?;
         let flags_v = flags_version(self.flags());
-        if !(kind.min_version().max(flags_v)..=kind.max_version().max(flags_v)).contains(&version)
-        {
+        if !(kind.min_version().max(flags_v)..=kind.max_version().max(flags_v)).contains(&version) {
             return Err(Error::BadVersion { version });
         }
         if !kind.length_ok(self.length()) {

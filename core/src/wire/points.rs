@@ -2,8 +2,7 @@
 
 use super::{
     emit_header, field, get_bytes, put_bytes, seal, EncodeError, Error, Packet, PacketKind,
-    VERSION_1,
-    CRC_LEN, HEADER_LEN, MAX_POINTS_PER_PACKET, POINTS_PREFIX_LEN,
+    CRC_LEN, HEADER_LEN, MAX_POINTS_PER_PACKET, POINTS_PREFIX_LEN, VERSION_1,
 };
 
 /// Length of one point record in bytes.

@@ -11,8 +11,8 @@
 
 use super::crc::Crc32;
 use super::{
-    field, PacketKind, CRC_LEN, FLAG_LINK_CHECKED, HEADER_LEN, MAX_PACKET_LEN, MIN_PACKET_LEN, SYNC,
-    VERSION,
+    field, PacketKind, CRC_LEN, FLAG_LINK_CHECKED, HEADER_LEN, MAX_PACKET_LEN, MIN_PACKET_LEN,
+    SYNC, VERSION,
 };
 
 /// What the start of the unread bytes holds.

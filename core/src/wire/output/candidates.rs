@@ -4,8 +4,7 @@
 //! point.
 
 use super::super::{
-    emit_header, field, seal, EncodeError, Error, Packet, PacketKind, CRC_LEN, HEADER_LEN,
-    VERSION,
+    emit_header, field, seal, EncodeError, Error, Packet, PacketKind, CRC_LEN, HEADER_LEN, VERSION,
 };
 use super::{OutputHeaderRepr, OutputPointRepr, OUTPUT_HEADER_LEN, OUTPUT_POINT_LEN};
 

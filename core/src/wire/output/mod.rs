@@ -24,8 +24,8 @@ mod tests;
 
 use super::{CRC_LEN, HEADER_LEN};
 
-pub(super) use columns::emit_output_fragment_columns;
 pub use candidates::{CandidatesRepr, CANDIDATES_PACKET_LEN};
+pub(super) use columns::emit_output_fragment_columns;
 pub use columns::OutputColumns;
 pub(super) use packet::emit_output_fragment;
 pub use packet::{OutputHeaderRepr, OutputPoints};

@@ -2,8 +2,9 @@
 //! header and points, and writing one fragment point by point.
 
 use super::super::{
-    emit_header, field, get_u16, get_u8, get_u32, get_u64, put_bytes, seal, EncodeError, Error, Packet,
-    PacketKind, CRC_LEN, MAX_OUTPUT_POINTS_PER_PACKET, VERSION, VERSION_1, flags_version,
+    emit_header, field, flags_version, get_u16, get_u32, get_u64, get_u8, put_bytes, seal,
+    EncodeError, Error, Packet, PacketKind, CRC_LEN, MAX_OUTPUT_POINTS_PER_PACKET, VERSION,
+    VERSION_1,
 };
 use super::{output_packet_len, OutputPointRepr, NO_INDEX, OUTPUT_POINT_LEN};
 

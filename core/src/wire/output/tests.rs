@@ -466,9 +466,13 @@ fn candidates_packet_round_trips_as_version_2() {
     assert!(buf[n - 4 - 16..n - 4].iter().all(|&b| b == 0));
     // A record without its index, or an index without its record, is refused.
     let bad = CandidatesRepr { right: c.left, ..c };
-    assert!(StreamEncoder::new().encode_candidates(&bad, &mut buf).is_err());
+    assert!(StreamEncoder::new()
+        .encode_candidates(&bad, &mut buf)
+        .is_err());
     let bad = CandidatesRepr { left: None, ..c };
-    assert!(StreamEncoder::new().encode_candidates(&bad, &mut buf).is_err());
+    assert!(StreamEncoder::new()
+        .encode_candidates(&bad, &mut buf)
+        .is_err());
     // Relabelled version 1 (CRC fixed): version 1 has no candidates packet.
     let mut v1 = buf[..n].to_vec();
     v1[2] = 1;
@@ -499,7 +503,9 @@ fn output_packets_take_version_2_only_for_the_outside_count() {
             outside,
             ..header(1)
         };
-        let n = StreamEncoder::new().encode_output(&h, &[pt], &mut buf).unwrap();
+        let n = StreamEncoder::new()
+            .encode_output(&h, &[pt], &mut buf)
+            .unwrap();
         let pk = Packet::new_checked(&buf[..n]).unwrap();
         assert_eq!(pk.version(), version);
         let (got, _) = OutputHeaderRepr::parse(&pk).unwrap();
@@ -528,7 +534,12 @@ fn link_checked_packets_are_read_without_a_crc() {
     let mut buf = [0u8; MAX_PACKET_LEN];
     let mut stream = Vec::new();
     let n = enc.encode_config(&[0; 16], &mut buf).unwrap();
-    assert_eq!(ConfigRepr::parse(&Packet::new_checked(&buf[..n]).unwrap()).unwrap().words, [0; 16]);
+    assert_eq!(
+        ConfigRepr::parse(&Packet::new_checked(&buf[..n]).unwrap())
+            .unwrap()
+            .words,
+        [0; 16]
+    );
     let pts: Vec<PointRecord> = (0..40)
         .map(|i| PointRecord {
             dt_ns: 1000 * i,
@@ -541,7 +552,10 @@ fn link_checked_packets_are_read_without_a_crc() {
         .collect();
     let n = enc.encode_points(5, &pts, &mut buf).unwrap();
     let pk = Packet::new_checked(&buf[..n]).unwrap();
-    assert_eq!((pk.version(), pk.flags(), pk.crc()), (2, FLAG_LINK_CHECKED, 0));
+    assert_eq!(
+        (pk.version(), pk.flags(), pk.crc()),
+        (2, FLAG_LINK_CHECKED, 0)
+    );
     assert!(pk.link_checked());
     assert_eq!(PointsRepr::parse(&pk).unwrap().points.len(), 40);
     assert_eq!(scan(&buf[..n], true), Scan::Packet { len: n });
@@ -556,7 +570,9 @@ fn link_checked_packets_are_read_without_a_crc() {
     assert!(PointsRepr::parse(&Packet::new_checked(&v1[..]).unwrap()).is_err());
     // Marking a packet written with a CRC gives the encoder's bytes.
     let mut plain = [0u8; MAX_PACKET_LEN];
-    let m = StreamEncoder::with_seq(1).encode_points(5, &pts, &mut plain).unwrap();
+    let m = StreamEncoder::with_seq(1)
+        .encode_points(5, &pts, &mut plain)
+        .unwrap();
     mark_link_checked(&mut plain[..m]);
     assert_eq!(plain[..m], buf[..n]);
     let mut ing = Ingest::<4096, 64>::new();
@@ -569,5 +585,8 @@ fn link_checked_packets_are_read_without_a_crc() {
         }
     }
     let c = ing.counters();
-    assert_eq!((points, c.crc_errors, c.bad_version, c.reserved_flags), (40, 0, 0, 0));
+    assert_eq!(
+        (points, c.crc_errors, c.bad_version, c.reserved_flags),
+        (40, 0, 0, 0)
+    );
 }
