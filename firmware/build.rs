@@ -1,6 +1,7 @@
 //! Puts the STM32F405's real memory map (the repository root's `memory.x`) and the stack
 //! placement (`stack.x`) on the linker's search path, and the defmt linker script when the
-//! `defmt` (QEMU) or `board` feature is on.
+//! `defmt` (QEMU) or `board` feature is on. The `m7` feature takes `memory-an500.x` instead
+//! (QEMU's mps2-an500).
 
 use std::{env, fs, path::PathBuf};
 
@@ -8,7 +9,12 @@ fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     let manifest = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets it"));
     // The one memory map of the part lives at the repository root (docs/spec.md §1); copy it verbatim.
-    let memory_x = manifest.join("../memory.x");
+    // The `m7` build runs on QEMU's mps2-an500 (Cortex-M7), whose memory starts at 0.
+    let memory_x = if env::var_os("CARGO_FEATURE_M7").is_some() {
+        manifest.join("memory-an500.x")
+    } else {
+        manifest.join("../memory.x")
+    };
     fs::copy(&memory_x, out.join("memory.x"))
         .unwrap_or_else(|e| panic!("copying {}: {e}", memory_x.display()));
     let stack_x = manifest.join("stack.x");
