@@ -13,7 +13,10 @@ fn within_epsilon(scene: &str) {
     let dir = tempfile::tempdir().unwrap();
     let spec = simulate::scene_by_name(scene).expect("scene exists");
     simulate::run(&spec, 1, None, dir.path(), false).expect("simulation runs");
-    let (pts, traj) = (dir.path().join("points.laz"), dir.path().join("trajectory.csv"));
+    let (pts, traj) = (
+        dir.path().join("points.laz"),
+        dir.path().join("trajectory.csv"),
+    );
     let whole = pipeline::extract_file(&pts, &traj, &Config::default()).unwrap();
     let streamed = stream::extract(
         std::slice::from_ref(&pts),
