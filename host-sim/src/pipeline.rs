@@ -184,6 +184,8 @@ pub struct Summary {
     pub dropped_before_trajectory: u64,
     /// Points after the trajectory's last time (dropped).
     pub dropped_after_trajectory: u64,
+    /// Points the stream's window dropped under its time cap (a standing vehicle).
+    pub dropped_by_window_cap: u64,
     /// The core's counters.
     pub core: ReplayCounters,
     /// Seed candidates from the core.
@@ -214,7 +216,7 @@ impl Summary {
         };
         format!(
             "points read        {read} of {file} in {path}\n\
-             dropped            {before} before and {after} after the trajectory, {trunc} in over-long lines, {lost} lost in the core, {irr} irregular (§2.4), {nn} without neighbours\n\
+             dropped            {before} before and {after} after the trajectory, {trunc} in over-long lines, {lost} lost in the core, {irr} irregular (§2.4), {nn} without neighbours{cap}\n\
              scanlines          {lines}\n\
              candidates         {cand}\n\
              edges              {edges}, total length {len:.1} m\n\
@@ -226,6 +228,14 @@ impl Summary {
             path = self.las.path.display(),
             before = self.dropped_before_trajectory,
             after = self.dropped_after_trajectory,
+            cap = if self.dropped_by_window_cap > 0 {
+                format!(
+                    ", {} by the window's time cap (vehicle standing)",
+                    self.dropped_by_window_cap
+                )
+            } else {
+                String::new()
+            },
             trunc = c.truncated,
             lost = c.lost,
             irr = c.irregular,
@@ -446,6 +456,7 @@ pub fn extract_file_with(
     let summary = Summary {
         dropped_before_trajectory: r.dropped.0,
         dropped_after_trajectory: r.dropped.1,
+        dropped_by_window_cap: 0,
         core: r.kernel.counters,
         candidates: r.kernel.candidates.len() as u64,
         edges: edges.len() as u64,
@@ -496,6 +507,7 @@ fn extract_qiu(
     let summary = Summary {
         dropped_before_trajectory: dropped.0,
         dropped_after_trajectory: dropped.1,
+        dropped_by_window_cap: 0,
         core: ReplayCounters::default(),
         candidates: 0,
         edges: edges.len() as u64,

@@ -31,3 +31,34 @@ pub fn peak_rss_bytes() -> u64 {
         })
         .map_or(0, |kb| kb * 1024)
 }
+
+/// CPU time of the calling thread so far, seconds (`/proc/thread-self/schedstat`, in
+/// nanoseconds; 0 where unavailable).
+pub fn thread_cpu_s() -> f64 {
+    schedstat_s("/proc/thread-self/schedstat")
+}
+
+/// CPU time so far of this process's live threads whose name starts with `prefix`,
+/// seconds (`/proc/self/task/*/comm` and `schedstat`; 0 where unavailable). Threads that
+/// have ended are not counted: read it while they run.
+pub fn named_threads_cpu_s(prefix: &str) -> f64 {
+    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
+        return 0.0;
+    };
+    tasks
+        .flatten()
+        .filter(|t| {
+            std::fs::read_to_string(t.path().join("comm"))
+                .is_ok_and(|c| c.trim_end().starts_with(prefix))
+        })
+        .map(|t| schedstat_s(&t.path().join("schedstat").to_string_lossy()))
+        .sum()
+}
+
+/// The first field of a `schedstat` file (time on a CPU, ns) in seconds.
+fn schedstat_s(path: &str) -> f64 {
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<u64>().ok())
+        .map_or(0.0, |ns| ns as f64 * 1e-9)
+}

@@ -88,6 +88,7 @@ fn one_section_as_long_as_the_street_is_the_whole_file_run_byte_for_byte() {
         &WindowParams {
             section_m: 1e9,
             margin_m: 0.0,
+            ..WindowParams::default()
         },
     );
     assert!(!whole.edges.is_empty());
@@ -129,6 +130,7 @@ fn one_section_as_long_as_the_street_is_the_whole_file_run_byte_for_byte() {
         &WindowParams {
             section_m: 2.0,
             margin_m: 0.5,
+            ..WindowParams::default()
         },
     );
     assert_ne!(canonical(&short.edges), canonical(&whole.edges));

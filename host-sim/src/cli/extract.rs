@@ -83,6 +83,11 @@ pub struct Args {
     /// tracker's reach; see docs/benchmarks.md).
     #[arg(long, default_value_t = WindowParams::default().margin_m)]
     pub margin_m: f64,
+    /// Most seconds of points the window holds: a vehicle standing longer closes its
+    /// section and drops its oldest points (counted in the summary). Bounds memory at this
+    /// span times the point rate.
+    #[arg(long, default_value_t = WindowParams::default().max_s)]
+    pub window_max_s: f64,
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -125,6 +130,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             let window = WindowParams {
                 section_m: args.section_m,
                 margin_m: args.margin_m,
+                max_s: args.window_max_s,
             };
             stream::extract(&args.points, trajectory, &cfg, &opts, &window, &progress)?
         }

@@ -47,12 +47,14 @@
 //! shifted to a local origin first so that squared distances keep their precision with large
 //! CRS offsets.
 
+pub mod agreement;
 mod matching;
 mod metrics;
 pub mod report;
 mod table;
 pub mod worst;
 
+pub use agreement::{agreement, Agreement};
 pub use metrics::{evaluate, CategoryMetrics, EvalReport, Metrics, SideMetrics};
 pub use table::category_title;
 pub use worst::{worst_place, WorstKind, WorstPlace};

@@ -25,9 +25,9 @@ use crate::io::las_in::ReadOptions;
 use crate::io::trajectory::{Trajectory, MIN_COVERED_FRACTION};
 use crate::model::EdgeLine;
 use crate::pipeline::{
-    ExtractError, ExtractOptions, ExtractResult, Method, Progress, StageTimes, Summary,
+    ExtractError, ExtractOptions, ExtractResult, Method, Progress, StageCpu, StageTimes, Summary,
 };
-use crate::proc_stats::{peak_rss_bytes, process_cpu_s};
+use crate::proc_stats::{named_threads_cpu_s, peak_rss_bytes, process_cpu_s, thread_cpu_s};
 use crate::replay::run::ReplayCounters;
 use crate::source::campaign::{Campaign, SourceError};
 use crate::source::external_sort::{SortedRuns, RUN_POINTS};
@@ -50,7 +50,7 @@ struct Pass {
     points: u64,
     time_span: Option<(f64, f64)>,
     candidates: u64,
-    peak_window_points: usize,
+    capped_points: u64,
     times: StageTimes,
 }
 
@@ -67,6 +67,11 @@ pub fn extract(
     if opts.method != Method::Bend {
         return Err(ExtractError::Method(opts.method.as_str().into()));
     }
+    // laz-rs decompresses on rayon's global pool, which nothing else in the stream uses:
+    // its threads are named for the reader when the process has not built it yet.
+    let _ = rayon::ThreadPoolBuilder::new()
+        .thread_name(|i| format!("{READ_THREADS}-{i}"))
+        .build_global();
     let start = Instant::now();
     let cpu0 = process_cpu_s();
     let traj = Trajectory::read_csv(traj_path)?;
@@ -133,13 +138,13 @@ pub fn extract(
         las: info.las_info(selected, selection, reordered),
         dropped_before_trajectory: pass.dropped.0,
         dropped_after_trajectory: pass.dropped.1,
+        dropped_by_window_cap: pass.capped_points,
         core: pass.counters,
         candidates: pass.candidates,
         edges: pass.edges.len() as u64,
         total_length_m: pass.edges.iter().map(|e| e.length_m()).sum(),
         times,
     };
-    let _ = pass.peak_window_points;
     Ok(ExtractResult {
         crs: info.crs.clone(),
         edges: pass.edges,
@@ -169,7 +174,14 @@ enum PassError {
     Core(core_stage::CoreError),
 }
 
-/// One pass: reader thread → core thread → window on this thread.
+/// Name of the reader thread and the prefix of its decoder pool's threads.
+const READ_THREADS: &str = "ct-read";
+
+/// One pass: reader thread → core thread → window on this thread. CPU per stage: the
+/// reader's is its thread's and the decoder's (rayon's global pool, threads named
+/// [`READ_THREADS`] when the stream named them), the
+/// edges' this thread's while it tracks, the core's the rest of the process's during the
+/// pass (the core thread and the pools it starts per batch).
 fn run_pass(
     spec: SourceSpec,
     traj: &Trajectory,
@@ -180,60 +192,80 @@ fn run_pass(
     bytes_total: u64,
 ) -> Result<(Pass, crate::io::las_in::ScannerSelection), PassError> {
     progress.stage_bytes("extract", bytes_total);
+    let cpu0 = process_cpu_s();
     let bytes_done = AtomicU64::new(0);
     let read_s = AtomicU64::new(0);
     let core_s = AtomicU64::new(0);
+    let read_thread_cpu = AtomicU64::new(0);
     std::thread::scope(|s| {
         let (tx_b, rx_b) = sync_channel::<Result<PointBatch, SourceError>>(1);
         let (tx_c, rx_c) = sync_channel::<Result<core_stage::CoreBatch, PassError>>(1);
         let bytes_done = &bytes_done;
-        let (read_s, core_s) = (&read_s, &core_s);
-        let reader = s.spawn(move || {
-            let mut busy = 0.0;
-            let mut source = match spec.open() {
-                Ok(s) => s,
-                Err(e) => {
-                    let _ = tx_b.send(Err(e));
-                    return crate::io::las_in::ScannerSelection::All;
-                }
-            };
-            loop {
-                let t0 = Instant::now();
-                let b = source.next_batch(STREAM_BATCH_POINTS);
-                busy += t0.elapsed().as_secs_f64();
-                bytes_done.store(source.bytes_done(), Ordering::Relaxed);
-                let stop = !matches!(b, Ok(Some(_)));
-                let msg = match b {
-                    Ok(Some(b)) => Ok(b),
-                    Ok(None) => break,
-                    Err(e) => Err(e),
-                };
-                if tx_b.send(msg).is_err() || stop {
-                    break;
-                }
-            }
-            read_s.store(busy.to_bits(), Ordering::Relaxed);
-            source.selection()
-        });
-        let core = s.spawn(move || {
-            let mut stage = core_stage::CoreStage::new(traj, *words, cfg.replay);
-            let mut busy = 0.0;
-            for b in rx_b {
-                let b = match b {
-                    Ok(b) => b,
+        let (read_s, core_s, read_thread_cpu) = (&read_s, &core_s, &read_thread_cpu);
+        let reader = std::thread::Builder::new()
+            .name(READ_THREADS.into())
+            .spawn_scoped(s, move || {
+                let mut busy = 0.0;
+                let mut source = match spec.open() {
+                    Ok(s) => s,
                     Err(e) => {
-                        let _ = tx_c.send(Err(PassError::Source(e)));
-                        return None;
+                        let _ = tx_b.send(Err(e));
+                        return crate::io::las_in::ScannerSelection::All;
                     }
                 };
-                let t0 = Instant::now();
-                let out = stage.push(b);
-                busy += t0.elapsed().as_secs_f64();
-                match out {
-                    Ok(Some(c)) => {
-                        if tx_c.send(Ok(c)).is_err() {
+                loop {
+                    let t0 = Instant::now();
+                    let b = source.next_batch(STREAM_BATCH_POINTS);
+                    busy += t0.elapsed().as_secs_f64();
+                    bytes_done.store(source.bytes_done(), Ordering::Relaxed);
+                    let stop = !matches!(b, Ok(Some(_)));
+                    let msg = match b {
+                        Ok(Some(b)) => Ok(b),
+                        Ok(None) => break,
+                        Err(e) => Err(e),
+                    };
+                    if tx_b.send(msg).is_err() || stop {
+                        break;
+                    }
+                }
+                read_s.store(busy.to_bits(), Ordering::Relaxed);
+                read_thread_cpu.store(thread_cpu_s().to_bits(), Ordering::Relaxed);
+                source.selection()
+            })
+            .expect("the reader thread starts");
+        let core = std::thread::Builder::new()
+            .name("ct-core".into())
+            .spawn_scoped(s, move || {
+                let mut stage = core_stage::CoreStage::new(traj, *words, cfg.replay);
+                let mut busy = 0.0;
+                for b in rx_b {
+                    let b = match b {
+                        Ok(b) => b,
+                        Err(e) => {
+                            let _ = tx_c.send(Err(PassError::Source(e)));
                             return None;
                         }
+                    };
+                    let t0 = Instant::now();
+                    let out = stage.push(b);
+                    busy += t0.elapsed().as_secs_f64();
+                    match out {
+                        Ok(Some(c)) => {
+                            if tx_c.send(Ok(c)).is_err() {
+                                return None;
+                            }
+                        }
+                        Ok(None) => {}
+                        Err(e) => {
+                            let _ = tx_c.send(Err(PassError::Core(e)));
+                            return None;
+                        }
+                    }
+                }
+                let t0 = Instant::now();
+                match stage.finish() {
+                    Ok(Some(c)) => {
+                        let _ = tx_c.send(Ok(c));
                     }
                     Ok(None) => {}
                     Err(e) => {
@@ -241,35 +273,26 @@ fn run_pass(
                         return None;
                     }
                 }
-            }
-            let t0 = Instant::now();
-            match stage.finish() {
-                Ok(Some(c)) => {
-                    let _ = tx_c.send(Ok(c));
-                }
-                Ok(None) => {}
-                Err(e) => {
-                    let _ = tx_c.send(Err(PassError::Core(e)));
-                    return None;
-                }
-            }
-            busy += t0.elapsed().as_secs_f64();
-            core_s.store(busy.to_bits(), Ordering::Relaxed);
-            Some((stage.counters, stage.dropped, stage.points, stage.time_span))
-        });
+                busy += t0.elapsed().as_secs_f64();
+                core_s.store(busy.to_bits(), Ordering::Relaxed);
+                Some((stage.counters, stage.dropped, stage.points, stage.time_span))
+            })
+            .expect("the core thread starts");
         let mut win = window::SectionWindow::new(traj, *window, cfg.bend.clone());
         let mut edges = Vec::new();
         let mut candidates = 0u64;
         let mut err = None;
         let mut edges_s = 0.0;
+        let mut edges_cpu = 0.0;
         for c in rx_c {
             progress.set(bytes_done.load(Ordering::Relaxed));
             match c {
                 Ok(c) => {
                     candidates += c.candidates.len() as u64;
-                    let t0 = Instant::now();
+                    let (t0, c0) = (Instant::now(), thread_cpu_s());
                     edges.extend(win.push(c));
                     edges_s += t0.elapsed().as_secs_f64();
+                    edges_cpu += thread_cpu_s() - c0;
                 }
                 Err(e) => {
                     err = Some(e);
@@ -277,6 +300,7 @@ fn run_pass(
                 }
             }
         }
+        // The reader thread has ended; its pool's threads still run.
         let selection = reader
             .join()
             .unwrap_or_else(|p| std::panic::resume_unwind(p));
@@ -289,14 +313,24 @@ fn run_pass(
                 crate::replay::run::ReplayError::Stalled,
             )));
         };
-        let t0 = Instant::now();
+        let (t0, c0) = (Instant::now(), thread_cpu_s());
         edges.extend(win.finish());
         edges_s += t0.elapsed().as_secs_f64();
+        edges_cpu += thread_cpu_s() - c0;
         progress.set(bytes_total);
+        let read_cpu = named_threads_cpu_s(READ_THREADS)
+            + f64::from_bits(read_thread_cpu.load(Ordering::Relaxed));
+        let total_cpu = process_cpu_s() - cpu0;
         let times = StageTimes {
             read_s: f64::from_bits(read_s.load(Ordering::Relaxed)),
             core_s: f64::from_bits(core_s.load(Ordering::Relaxed)),
             edges_s,
+            cpu: StageCpu {
+                read_s: read_cpu,
+                core_s: (total_cpu - read_cpu - edges_cpu).max(0.0),
+                edges_s: edges_cpu,
+                ..StageCpu::default()
+            },
             ..StageTimes::default()
         };
         Ok((
@@ -307,7 +341,7 @@ fn run_pass(
                 points,
                 time_span,
                 candidates,
-                peak_window_points: win.peak_points,
+                capped_points: win.capped_points,
                 times,
             },
             selection,

@@ -37,16 +37,22 @@ pub struct WindowParams {
     /// edge vertices by the station nearest to them; the two differ by up to the lateral
     /// range times the tangent of the scanner's yaw and on curves. The margin covers that
     /// difference plus the reach of a track from its seed and of the post-filters, so that
-    /// an edge inside the section sees what it would see in a whole-file run; the named
-    /// scenes need 20 m for identical geometry (docs/benchmarks.md).
+    /// an edge inside the section sees what it would see in a whole-file run (the default
+    /// window and its cost against others: docs/benchmarks.md).
     pub margin_m: f64,
+    /// Most seconds of points the window holds. A vehicle that stands or creeps does not
+    /// advance the route, so its points would pile up in one section: past this span the
+    /// window closes the section at the vehicle's station and drops the oldest points it
+    /// still holds (counted), so memory is bounded by this span times the point rate.
+    pub max_s: f64,
 }
 
 impl Default for WindowParams {
     fn default() -> Self {
         Self {
-            section_m: 10.0,
-            margin_m: 20.0,
+            section_m: 60.0,
+            margin_m: 10.0,
+            max_s: 20.0,
         }
     }
 }
@@ -128,12 +134,18 @@ pub struct SectionWindow<'a> {
     params: WindowParams,
     bend: BendParams,
     cols: Columns,
-    /// Index of the next section to run.
-    next: i64,
+    /// Station where the next section starts.
+    start: f64,
     merge: Merge,
     /// Most points the window held at once.
     pub peak_points: usize,
+    /// Points dropped by the time cap (`max_s`).
+    pub capped_points: u64,
 }
+
+/// Least progress along the route, metres, for which the time cap closes a section early;
+/// below it (a standing vehicle) the cap only drops the oldest points.
+const CAP_MIN_SECTION_M: f64 = 1.0;
 
 impl<'a> SectionWindow<'a> {
     /// A window over `traj`'s route.
@@ -147,14 +159,19 @@ impl<'a> SectionWindow<'a> {
             bend,
             params,
             cols: Columns::default(),
-            next: 0,
+            start: 0.0,
             merge: Merge::new(stitch, min_len),
             peak_points: 0,
+            capped_points: 0,
         }
     }
 
     fn section_m(&self) -> f64 {
         self.params.section_m.max(1.0)
+    }
+
+    fn margin_m(&self) -> f64 {
+        self.params.margin_m.max(0.0)
     }
 
     fn station(&self, t: f64) -> f64 {
@@ -171,16 +188,38 @@ impl<'a> SectionWindow<'a> {
         self.cols.append(b);
         self.peak_points = self.peak_points.max(self.cols.len());
         let mut out = Vec::new();
-        if self.single() {
-            return out;
-        }
-        let Some(&t_last) = self.cols.t.last() else {
+        let (Some(&t_first), Some(&t_last)) = (self.cols.t.first(), self.cols.t.last()) else {
             return out;
         };
         let s_last = self.station(t_last);
-        let l = self.section_m();
-        while (self.next + 1) as f64 * l + self.params.margin_m.max(0.0) <= s_last {
-            out.extend(self.run_section());
+        if self.single() {
+            // A section longer than the route asks for the whole input in one window.
+            return out;
+        }
+        let (l, m) = (self.section_m(), self.margin_m());
+        while self.start + l + m <= s_last {
+            out.extend(self.run_section(self.start + l));
+        }
+        if t_last - t_first > self.params.max_s.max(0.0) {
+            out.extend(self.cap(t_last, s_last));
+        }
+        out
+    }
+
+    /// The time cap: closes the section at the vehicle's station `s_last` when the vehicle
+    /// has moved on since the section started, then drops the points older than `max_s`
+    /// before `t_last`.
+    fn cap(&mut self, t_last: f64, s_last: f64) -> Vec<EdgeLine> {
+        let out = if s_last >= self.start + CAP_MIN_SECTION_M {
+            self.run_section(s_last)
+        } else {
+            Vec::new()
+        };
+        let cut = t_last - self.params.max_s.max(0.0);
+        let n = self.cols.t.partition_point(|&t| t <= cut);
+        if n > 0 {
+            self.capped_points += n as u64;
+            self.cols.evict(n);
         }
         out
     }
@@ -197,19 +236,18 @@ impl<'a> SectionWindow<'a> {
         let mut out = Vec::new();
         let l = self.section_m();
         let end = self.route.length_m();
-        while (self.next as f64) * l <= end && !self.cols.t.is_empty() {
-            out.extend(self.run_section());
+        while self.start <= end && !self.cols.t.is_empty() {
+            out.extend(self.run_section(self.start + l));
         }
         out.extend(self.merge.close_all());
         out
     }
 
-    /// Runs section `next`, then evicts the points the next section does not need.
-    fn run_section(&mut self) -> Vec<EdgeLine> {
-        let l = self.section_m();
-        let m = self.params.margin_m.max(0.0);
-        let k = self.next;
-        let (s0, s1) = (k as f64 * l, (k + 1) as f64 * l);
+    /// Runs the section `[start, s1)`, then evicts the points the next section does not
+    /// need.
+    fn run_section(&mut self, s1: f64) -> Vec<EdgeLine> {
+        let m = self.margin_m();
+        let s0 = self.start;
         let lo = self.cols.t.partition_point(|&t| self.station(t) < s0 - m);
         let hi = self.cols.t.partition_point(|&t| self.station(t) < s1 + m);
         let edges = if hi > lo {
@@ -222,7 +260,7 @@ impl<'a> SectionWindow<'a> {
             pieces.extend(cut_to_section(&self.route, e, steps, s0, s1));
         }
         let closed = self.merge.push(pieces, s0, s1);
-        self.next += 1;
+        self.start = s1;
         let keep_from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
         self.cols.evict(keep_from);
         closed
@@ -295,4 +333,76 @@ fn cut_to_section(
         ));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// A drive along x: 10 m/s for 5 s, standing for 200 s, 10 m/s for 5 s more.
+    fn stop_and_go() -> Trajectory {
+        let mut csv = String::from("time,x,y,z,roll,pitch,heading\n");
+        let mut x = 0.0;
+        for k in 0..=2100 {
+            let t = k as f64 * 0.1;
+            if !(5.0..205.0).contains(&t) && k > 0 {
+                x += 1.0;
+            }
+            csv.push_str(&format!("{t},{x},0,2,0,0,90\n"));
+        }
+        Trajectory::parse_csv(Path::new("stop.csv"), &csv).expect("trajectory parses")
+    }
+
+    /// One second of points from `t0`: 20 000 points a second, none processed by the core.
+    fn second(base: u64, t0: f64) -> CoreBatch {
+        let n = 20_000;
+        let t: Vec<f64> = (0..n).map(|i| t0 + i as f64 / n as f64).collect();
+        CoreBatch {
+            base,
+            x: vec![0.0; n],
+            y: vec![3.0; n],
+            z: vec![0.0; n],
+            t,
+            rho_deg: vec![0.0; n],
+            status: vec![None; n],
+            scanline: vec![0; n],
+            candidates: Vec::new(),
+        }
+    }
+
+    fn drive(max_s: f64) -> SectionWindow<'static> {
+        let traj = Box::leak(Box::new(stop_and_go()));
+        let params = WindowParams {
+            max_s,
+            ..WindowParams::default()
+        };
+        let mut w = SectionWindow::new(traj, params, BendParams::default());
+        for s in 0..209 {
+            w.push(second(s * 20_000, s as f64));
+        }
+        w.finish();
+        w
+    }
+
+    #[test]
+    fn a_standing_vehicle_does_not_grow_the_window_past_its_time_cap() {
+        let capped = drive(20.0);
+        // At most the cap's 20 s and the batch that passed it (and a point at the cap's
+        // edge, as the times round).
+        assert!(
+            capped.peak_points <= 21 * 20_000 + 1,
+            "{}",
+            capped.peak_points
+        );
+        assert!(
+            capped.capped_points >= 150 * 20_000,
+            "{}",
+            capped.capped_points
+        );
+        // Without the cap the window holds the whole stop.
+        let open = drive(f64::INFINITY);
+        assert!(open.peak_points >= 200 * 20_000, "{}", open.peak_points);
+        assert_eq!(open.capped_points, 0);
+    }
 }
