@@ -145,6 +145,7 @@ pub fn reference_lines(
                         category: Some(cat),
                         method: None,
                         curb_height_m: Some(hs[hs.len() / 2]),
+                        detail: None,
                     });
                 }
             }
