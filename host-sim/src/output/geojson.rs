@@ -26,11 +26,14 @@ pub fn lines_to_geojson(lines: &[EdgeLine], crs: Option<&Crs>) -> serde_json::Va
             if let Some(d) = &l.detail {
                 props.insert("line".into(), json!(f.kind.as_str()));
                 props.insert("edge".into(), json!(f.edge));
-                props.insert("bridged".into(), json!(d.bridged));
-                props.insert(
-                    "support_per_m".into(),
-                    json!(round_to(d.support_per_m, 1e-2)),
-                );
+                // Reference lines (no method) are not extracted: no support to tell.
+                if l.method.is_some() {
+                    props.insert("bridged".into(), json!(d.bridged));
+                    props.insert(
+                        "support_per_m".into(),
+                        json!(round_to(d.support_per_m, 1e-2)),
+                    );
+                }
                 if f.kind == LineKind::Toe {
                     let hs: Vec<f64> = d.height_m.iter().map(|&h| round_to(h, 1e-4)).collect();
                     props.insert("heights_m".into(), json!(hs));
