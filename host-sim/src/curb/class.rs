@@ -10,9 +10,15 @@ use crate::model::{Category, CurbDetail, EdgeLine, Side};
 /// Angle between the edge and the route above which a vertex is on an intersection
 /// (corner arc or side street), degrees.
 pub const TURN_DEG: f64 = 30.0;
-/// How far a vertex stands out from its side's curb line to be on a bus bay or setback,
-/// metres.
+/// How much wider than usual the road is at a bus bay or setback, metres.
 pub const BAY_MIN_M: f64 = 0.5;
+/// How far a vertex with no curb on the other side stands out from its side's usual
+/// offset to be on a bus bay, metres: the bay's threshold plus a lane's slack for the
+/// vehicle's wander.
+pub const BAY_ALONE_M: f64 = 1.2;
+/// Reach along the route within which the other side's curb counts as beside a vertex,
+/// metres.
+pub const PAIR_M: f64 = 1.0;
 /// Highest curb at a curb cut (a lowered curb's lip, a ramp), metres.
 pub const CUT_MAX_M: f64 = 0.05;
 /// Shortest low run that is a flush edge rather than a curb cut, metres (curb cuts for
@@ -20,15 +26,21 @@ pub const CUT_MAX_M: f64 = 0.05;
 pub const FLUSH_MIN_M: f64 = 20.0;
 /// Shortest stretch of one class; shorter runs join their neighbour.
 pub const MIN_RUN_M: f64 = 1.0;
-/// Share of a side's vertices (not turned) taken as the line of its curb: the offset below
+/// Share of the vertices (not turned) taken as the usual width or offset: the value below
 /// which this share lies.
 const LINE_QUANTILE: f64 = 0.2;
 
 /// Sets the class of every vertex of `edges` (those with detail), from their heights, their
-/// direction against the route and their offset from it.
+/// direction against the route and how far they stand out from the curb line.
+///
+/// The vehicle wanders in its lane, so a curb's offset from the route alone moves by as
+/// much as a lane's slack; the road's width does not. Where the other side's curb runs
+/// beside a vertex (within [`PAIR_M`] of its station), the vertex stands out by the width
+/// there minus the usual width; elsewhere by its offset minus its side's usual offset,
+/// against a threshold that allows for the wander.
 pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
-    // Per vertex: (turned, offset from the route).
-    let geo: Vec<Vec<(bool, f64)>> = edges
+    // Per vertex: (turned, offset from the route, station).
+    let geo: Vec<Vec<(bool, f64, f64)>> = edges
         .iter()
         .map(|e| {
             (0..e.points.len())
@@ -40,40 +52,73 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
                             (
                                 c.acos().to_degrees() > TURN_DEG,
                                 (p[0] - q[0]).hypot(p[1] - q[1]),
+                                route.station_near(p[0], p[1]).unwrap_or(f64::NAN),
                             )
                         }
-                        _ => (false, f64::NAN),
+                        _ => (false, f64::NAN, f64::NAN),
                     }
                 })
                 .collect()
         })
         .collect();
-    // The line of each side's curb: a low quantile of the offsets of the vertices that run
-    // along the route.
-    let line = |side: Side| -> Option<f64> {
-        let mut v: Vec<f64> = edges
-            .iter()
-            .zip(&geo)
-            .filter(|(e, _)| e.side == side)
-            .flat_map(|(_, g)| g.iter().filter(|g| !g.0 && g.1.is_finite()).map(|g| g.1))
-            .collect();
+    // Vertices running along the route, per side, by station: (station, offset).
+    let mut along: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
+    for (e, g) in edges.iter().zip(&geo) {
+        let s = usize::from(e.side == Side::Right);
+        along[s].extend(
+            g.iter()
+                .filter(|g| !g.0 && g.1.is_finite() && g.2.is_finite())
+                .map(|g| (g.2, g.1)),
+        );
+    }
+    for a in along.iter_mut() {
+        a.sort_unstable_by(|p, q| p.0.total_cmp(&q.0));
+    }
+    // The other side's offset at `station`: the median within PAIR_M.
+    let beside = |side: usize, station: f64| -> Option<f64> {
+        let a = &along[1 - side];
+        let lo = a.partition_point(|p| p.0 < station - PAIR_M);
+        let hi = a.partition_point(|p| p.0 <= station + PAIR_M);
+        let mut v: Vec<f64> = a[lo..hi].iter().map(|p| p.1).collect();
+        super::median(&mut v)
+    };
+    let quantile = |mut v: Vec<f64>| -> Option<f64> {
         if v.is_empty() {
             return None;
         }
         v.sort_unstable_by(f64::total_cmp);
         Some(v[((v.len() - 1) as f64 * LINE_QUANTILE) as usize])
     };
-    let lines = [line(Side::Left), line(Side::Right)];
+    let width_line = quantile(
+        along[0]
+            .iter()
+            .filter_map(|&(st, off)| beside(0, st).map(|o| o + off))
+            .collect(),
+    );
+    let side_line = [
+        quantile(along[0].iter().map(|p| p.1).collect()),
+        quantile(along[1].iter().map(|p| p.1).collect()),
+    ];
     for (e, g) in edges.iter_mut().zip(&geo) {
-        let base = lines[usize::from(e.side == Side::Right)];
+        let side = usize::from(e.side == Side::Right);
         let Some(d) = e.detail.as_mut() else { continue };
         d.class = g
             .iter()
             .zip(&d.height_m)
-            .map(|(&(turned, off), &h)| {
+            .map(|(&(turned, off, station), &h)| {
+                let stand_out = |o: f64, s: usize| side_line[s].map_or(0.0, |l| o - l);
+                let out_by = match (beside(side, station), width_line) {
+                    // The wider road is this side's bay when this side's curb stands out
+                    // more than the other's.
+                    (Some(o), Some(w)) if stand_out(off, side) >= stand_out(o, 1 - side) => {
+                        off + o - w - BAY_MIN_M
+                    }
+                    (Some(_), Some(_)) => f64::NEG_INFINITY,
+                    _ => side_line[side].map_or(f64::NEG_INFINITY, |l| off - l - BAY_ALONE_M),
+                };
                 if turned {
                     Category::Intersection
-                } else if base.is_some_and(|b| off - b > BAY_MIN_M) {
+                } else if out_by > 0.0 {
                     Category::BusBay
                 } else if h < CUT_MAX_M {
                     Category::CurbCut

@@ -86,7 +86,8 @@ impl SurveyReport {
                     .iter()
                     .filter(|x| x.0 == r && x.1 == c)
                     .map(|x| x.2)
-                    .sum();
+                    .sum::<f64>()
+                    + 0.0;
                 s.push_str(&format!(" {v:.1} |"));
             }
             s.push('\n');
