@@ -77,8 +77,11 @@ pub fn lines_to_geojson(lines: &[EdgeLine], crs: Option<&Crs>) -> serde_json::Va
     Value::Object(fc)
 }
 
+/// `v` rounded to a multiple of `step` (a power of ten), dividing by the integer `1 / step`
+/// so that the result is the nearest `f64` to the decimal (0.148, not 0.14800000000000002).
 fn round_to(v: f64, step: f64) -> f64 {
-    (v / step).round() * step
+    let inv = (1.0 / step).round();
+    (v * inv).round() / inv
 }
 
 /// Writes lines to a GeoJSON file.
