@@ -280,7 +280,10 @@ fn the_binary_formats_keep_every_property_and_vertex() {
                 let top = feature_block(&info, d.top[0])
                     .unwrap_or_else(|| panic!("{ext}: top of edge {i} not found:\n{info}"));
                 assert!(top.contains("line (String) = top"), "{ext}:\n{top}");
-                assert!(top.contains(&format!("edge (Integer64) = {i}")), "{ext}:\n{top}");
+                assert!(
+                    top.contains(&format!("edge (Integer64) = {i}")),
+                    "{ext}:\n{top}"
+                );
                 let bridged = if d.bridged { "1" } else { "0" };
                 assert!(
                     top.contains(&format!("bridged (Integer(Boolean)) = {bridged}")),
@@ -412,7 +415,11 @@ fn writing_over_an_existing_file_replaces_it() {
         let path = dir.path().join(format!("edges.{ext}"));
         write_edges(&path, &edges(0.0, 0.0), None).unwrap();
         write_edges(&path, &edges(0.0, 0.0)[..2], None).unwrap();
-        assert_opens(&path, OutputFormat::from_path(&path).unwrap().name(), 2 + WITH_TOP);
+        assert_opens(
+            &path,
+            OutputFormat::from_path(&path).unwrap().name(),
+            2 + WITH_TOP,
+        );
     }
 }
 
@@ -439,7 +446,11 @@ fn the_geojson_schema_version_round_trips_and_a_newer_major_is_refused() {
                 for (p, q) in x.top.iter().zip(&y.top) {
                     assert!((0..3).all(|k| near(p[k], q[k])), "{p:?} vs {q:?}");
                 }
-                assert!(x.height_m.iter().zip(&y.height_m).all(|(a, b)| near(*a, *b)));
+                assert!(x
+                    .height_m
+                    .iter()
+                    .zip(&y.height_m)
+                    .all(|(a, b)| near(*a, *b)));
                 assert_eq!((x.bridged, x.support_per_m), (y.bridged, y.support_per_m));
             }
             (None, None) => {}

@@ -100,9 +100,7 @@ pub(crate) fn tangent(p: &[[f64; 3]], k: usize, half_m: f64) -> Option<[f64; 2]>
 pub(crate) fn outward(route: &Route, p: [f64; 3], tan: [f64; 2]) -> [f64; 2] {
     let nrm = [-tan[1], tan[0]];
     match route.nearest(p[0], p[1]) {
-        Some((q, _)) if nrm[0] * (p[0] - q[0]) + nrm[1] * (p[1] - q[1]) < 0.0 => {
-            [-nrm[0], -nrm[1]]
-        }
+        Some((q, _)) if nrm[0] * (p[0] - q[0]) + nrm[1] * (p[1] - q[1]) < 0.0 => [-nrm[0], -nrm[1]],
         _ => nrm,
     }
 }

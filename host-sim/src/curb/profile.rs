@@ -58,7 +58,11 @@ fn line(p: impl Iterator<Item = (f64, f64)>) -> Option<(f64, f64, usize)> {
 /// fit are left out of the second.
 fn robust_line(p: &[(f64, f64)], tol: f64) -> Option<(f64, f64, usize)> {
     let (a, b, _) = line(p.iter().copied())?;
-    line(p.iter().copied().filter(|&(u, v)| (v - a - b * u).abs() <= tol))
+    line(
+        p.iter()
+            .copied()
+            .filter(|&(u, v)| (v - a - b * u).abs() <= tol),
+    )
 }
 
 /// Fits the curb on a cross-section `pts` of `(c, z)`: `c` across the toe (0 at the toe
@@ -139,12 +143,12 @@ mod tests {
     use super::*;
 
     /// A curb of height `h` with the face from c = 0 rising at batter `b` (run per rise),
-    /// a road falling 2 % towards it and a top rising 2 % away, sampled every 5 mm, with a
+    /// a road falling 2 % towards it and a top rising 2 % away, sampled every millimetre, with a
     /// rounded arris of radius 15 mm approximated by dropping the points within it.
     fn section(h: f64, batter: f64) -> Vec<(f64, f64)> {
         let run = batter * h;
-        (-100..=80)
-            .map(|i| i as f64 * 0.005)
+        (-450..=350)
+            .map(|i| i as f64 * 0.001)
             .filter_map(|c: f64| {
                 let z = if c <= 0.0 {
                     -0.02 * c

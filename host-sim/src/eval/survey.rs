@@ -57,7 +57,9 @@ impl SurveyReport {
                 pct(m.completeness_pct),
                 pct(m.correctness_pct)
             )),
-            None => s.push_str("- top of curb: – (no top lines in the reference or the extraction)\n"),
+            None => {
+                s.push_str("- top of curb: – (no top lines in the reference or the extraction)\n")
+            }
         }
         s.push_str(&format!(
             "- height within ±{:.0} mm on curbs ≥ {:.0} mm: {} of {:.1} m\n",
@@ -178,11 +180,7 @@ pub fn survey(
             if r == class {
                 out.class_right_m += w;
             }
-            match out
-                .confusion
-                .iter_mut()
-                .find(|c| c.0 == r && c.1 == class)
-            {
+            match out.confusion.iter_mut().find(|c| c.0 == r && c.1 == class) {
                 Some(c) => c.2 += w,
                 None => out.confusion.push((r, class, w)),
             }
@@ -218,7 +216,7 @@ mod tests {
     fn top_rms_height_share_and_confusion() {
         let reference = vec![
             line(0.0, 10.0, 0.0, Category::Curb, 0.15, 0.015),
-            line(10.0, 20.0, 0.0, Category::CurbCut, 0.02, 0.0),
+            line(10.0, 20.0, 0.0, Category::CurbCut, 0.02, 0.015),
         ];
         // Top 10 mm off the reference top; height 5 mm off on the first 5 m, 30 mm off on
         // the next 5 m; the curb cut called a curb on its first 4 m.
@@ -227,7 +225,7 @@ mod tests {
         let b = line(5.0, 14.0, 0.0, Category::Curb, 0.18, 0.025);
         let c = line(14.0, 20.0, 0.0, Category::CurbCut, 0.02, 0.025);
         let r = survey(&reference, &[a, b, c], &EvalParams::default()).unwrap();
-        let top = r.top.unwrap();
+        let top = r.top.clone().unwrap();
         assert!((top.rms_mm.unwrap() - 10.0).abs() < 0.5, "{top:?}");
         // Heights: only the reference curb (≥ 60 mm) counts: 10 m, half of it within.
         assert!((r.height_checked_m - 10.0).abs() < 0.15, "{r:?}");

@@ -273,7 +273,6 @@ pub fn write_gpkg(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Side;
 
     #[test]
     fn the_geometry_blob_is_a_gpkg_header_and_iso_wkb_linestring_z() {

@@ -287,7 +287,10 @@ pub fn run(
     let mut reference_m = [0.0; 4];
     for l in &sim.reference {
         if let Some(c) = l.category {
-            let i = Category::REFERENCE.iter().position(|&x| x == c).unwrap_or(0);
+            let i = Category::REFERENCE
+                .iter()
+                .position(|&x| x == c)
+                .unwrap_or(0);
             reference_m[i] += l.length_m();
         }
     }

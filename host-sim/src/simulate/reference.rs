@@ -17,9 +17,9 @@
 //! side street's curbs. The side is the sign of the segment midpoint's lateral offset x′
 //! from the nearest trajectory sample (docs/spec.md §2: left positive).
 
+use super::ground::ToeLine;
 use super::ground::{Ground, ToeCoord};
 use crate::io::trajectory::Trajectory;
-use super::ground::ToeLine;
 use crate::model::{Category, CurbDetail, EdgeLine, Side};
 
 /// Half window along the toe, metres.
