@@ -16,6 +16,7 @@
 //! | `rings` | spinning lidars: rings cut into half-arcs as scanlines, per-sensor kernel defaults |
 //! | `frame` | curbs in one lidar frame: half-arcs through the core, step check, linking, output |
 //! | `bend` | seeding (§2.6), tracking (§2.7), post-filters |
+//! | `curb` | the curb beside each toe: top of curb, height per vertex, class and support of every stretch |
 //! | `output` | sinks: GeoJSON and CSV writers of the edges |
 //! | `proc_stats` | CPU time and peak memory of this process, from `/proc` |
 //! | `qiu` | the second method (Qiu et al. 2016) |
@@ -25,6 +26,7 @@
 
 pub mod bend;
 pub mod config;
+pub mod curb;
 pub mod eval;
 pub mod frame;
 pub mod io;

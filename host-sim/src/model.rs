@@ -33,17 +33,22 @@ pub enum Category {
     CurbCut,
     /// An intersection corner where the curb turns.
     Intersection,
-    /// A bus bay, not parallel to the trajectory.
+    /// A bus bay or setback: the curb swings out from its line and back, not parallel to
+    /// the trajectory on the tapers.
     BusBay,
+    /// A flush edge: road meeting the verge or paving with no step, longer than a curb
+    /// cut (extracted lines only; the reference has no such category).
+    Flush,
 }
 
 impl Category {
     /// All categories, in table order.
-    pub const ALL: [Category; 4] = [
+    pub const ALL: [Category; 5] = [
         Category::Curb,
         Category::CurbCut,
         Category::Intersection,
         Category::BusBay,
+        Category::Flush,
     ];
 
     /// The GeoJSON spelling.
@@ -53,8 +58,18 @@ impl Category {
             Category::CurbCut => "curb_cut",
             Category::Intersection => "intersection",
             Category::BusBay => "bus_bay",
+            Category::Flush => "flush",
         }
     }
+
+    /// The categories a reference line can have (the simulator's and a surveyor's
+    /// reference), in table order.
+    pub const REFERENCE: [Category; 4] = [
+        Category::Curb,
+        Category::CurbCut,
+        Category::Intersection,
+        Category::BusBay,
+    ];
 
     /// Parses the GeoJSON spelling.
     pub fn parse(s: &str) -> Option<Self> {
@@ -116,9 +131,106 @@ pub struct EdgeLine {
     pub method: Option<String>,
     /// Median height step across the edge, metres, where known.
     pub curb_height_m: Option<f64>,
+    /// The surveyed curb beside the toe, per vertex (extracted lines from the bend method);
+    /// `None` for reference lines and lines read from files without it.
+    pub detail: Option<Box<CurbDetail>>,
+}
+
+/// The curb beside a toe line, one entry per vertex of the toe (docs/spec.md §2, "Curb
+/// geometry").
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct CurbDetail {
+    /// Top of curb (the arris) beside each toe vertex, `[x, y, z]` in the LAS CRS.
+    pub top: Vec<[f64; 3]>,
+    /// Curb height at each vertex, metres: top z − toe z.
+    pub height_m: Vec<f64>,
+    /// Whether each toe vertex rests on an observed candidate (true) or was placed by the
+    /// tracker between observations (a virtual profile's toe, a bridged gap).
+    pub measured: Vec<bool>,
+    /// Whether the top at each vertex was measured on a profile (true) or interpolated
+    /// from the measured ones beside it.
+    pub top_measured: Vec<bool>,
+    /// The class of the edge at each vertex (the stretches are cut where it changes).
+    pub class: Vec<Category>,
+    /// The stretch's kind of support: `true` when it was bridged (most of it placed by the
+    /// tracker, no observed candidate for at least [`BRIDGED_MIN_M`]), set when an edge is
+    /// cut into stretches.
+    pub bridged: bool,
+    /// Observed candidates (one per scanline crossing the toe) per metre of the stretch.
+    pub support_per_m: f64,
+}
+
+/// Shortest run of bridged toe vertices that makes a stretch of its own, metres; shorter
+/// runs stay in the measured stretch around them.
+pub const BRIDGED_MIN_M: f64 = 1.0;
+
+impl CurbDetail {
+    /// Per-vertex detail for `n` vertices with every vertex measured and no top known.
+    pub fn measured(toe: &[[f64; 3]]) -> Self {
+        Self {
+            top: toe.to_vec(),
+            height_m: vec![0.0; toe.len()],
+            measured: vec![true; toe.len()],
+            top_measured: vec![false; toe.len()],
+            class: vec![Category::Curb; toe.len()],
+            bridged: false,
+            support_per_m: 0.0,
+        }
+    }
+
+    /// Vertices `a..b`.
+    pub fn slice(&self, a: usize, b: usize) -> Self {
+        Self {
+            top: self.top[a..b].to_vec(),
+            height_m: self.height_m[a..b].to_vec(),
+            measured: self.measured[a..b].to_vec(),
+            top_measured: self.top_measured[a..b].to_vec(),
+            class: self.class[a..b].to_vec(),
+            bridged: self.bridged,
+            support_per_m: self.support_per_m,
+        }
+    }
+
+    /// `self` followed by `other`.
+    pub fn append(&mut self, other: &Self) {
+        self.top.extend_from_slice(&other.top);
+        self.height_m.extend_from_slice(&other.height_m);
+        self.measured.extend_from_slice(&other.measured);
+        self.top_measured.extend_from_slice(&other.top_measured);
+        self.class.extend_from_slice(&other.class);
+    }
 }
 
 impl EdgeLine {
+    /// Vertices `a..b` with their detail, the other properties as they are.
+    pub fn sub(&self, a: usize, b: usize) -> Self {
+        Self {
+            points: self.points[a..b].to_vec(),
+            detail: self.detail.as_ref().map(|d| Box::new(d.slice(a, b))),
+            ..self.clone()
+        }
+    }
+
+    /// `self` continued by `other`'s vertices (and detail, where both have it); the other
+    /// properties are `other`'s.
+    pub fn joined(&self, other: &Self) -> Self {
+        let mut points = self.points.clone();
+        points.extend_from_slice(&other.points);
+        let detail = match (&self.detail, &other.detail) {
+            (Some(a), Some(b)) => {
+                let mut d = a.clone();
+                d.append(b);
+                Some(d)
+            }
+            _ => None,
+        };
+        Self {
+            points,
+            detail,
+            ..other.clone()
+        }
+    }
+
     /// Horizontal (2D) length in metres.
     pub fn length_m(&self) -> f64 {
         self.points
@@ -151,7 +263,9 @@ pub enum GeoJsonError {
 
 /// Reads LineString / MultiLineString features from a GeoJSON file. A MultiLineString
 /// becomes one [`EdgeLine`] per part. `side` is required; `category`, `method` and
-/// `curb_height_m` are optional.
+/// `curb_height_m` are optional. Features with `line` = `top` (schema 2) are not lines of
+/// their own: each becomes the [`CurbDetail`] top of the toe feature with the same `edge`,
+/// whose `heights_m`, `bridged` and `support_per_m` fill the rest of the detail.
 pub fn read_geojson(path: &std::path::Path) -> Result<(Vec<EdgeLine>, Option<Crs>), GeoJsonError> {
     let p = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|source| GeoJsonError::Io {
@@ -186,8 +300,21 @@ pub fn read_geojson(path: &std::path::Path) -> Result<(Vec<EdgeLine>, Option<Crs
         .and_then(|f| f.as_array())
         .ok_or_else(|| fmt("FeatureCollection without a features array".into()))?;
     let mut out = Vec::new();
+    // Schema 2: top-of-curb features, by the `edge` of their toe, and each toe's `edge`.
+    let mut tops: std::collections::HashMap<u64, Vec<[f64; 3]>> = Default::default();
+    let mut toe_edge: Vec<Option<u64>> = Vec::new();
     for (i, f) in features.iter().enumerate() {
         let props = f.get("properties").cloned().unwrap_or_default();
+        let is_top = match props.get("line").and_then(|s| s.as_str()) {
+            None | Some("toe") => false,
+            Some("top") => true,
+            Some(other) => {
+                return Err(fmt(format!(
+                    "feature {i}: property line must be \"toe\" or \"top\", found {other:?}"
+                )))
+            }
+        };
+        let edge = props.get("edge").and_then(|e| e.as_u64());
         let side = match props.get("side").and_then(|s| s.as_str()) {
             Some("left") => Side::Left,
             Some("right") => Side::Right,
@@ -248,13 +375,49 @@ pub fn read_geojson(path: &std::path::Path) -> Result<(Vec<EdgeLine>, Option<Crs
                 };
                 points.push([x, y, get(2).unwrap_or(0.0)]);
             }
+            if is_top {
+                if let Some(k) = edge {
+                    tops.insert(k, points);
+                }
+                continue;
+            }
+            let detail = props
+                .get("heights_m")
+                .and_then(|h| h.as_array())
+                .filter(|h| h.len() == points.len())
+                .map(|h| {
+                    let bridged = props.get("bridged").and_then(|b| b.as_bool()) == Some(true);
+                    let n = points.len();
+                    Box::new(CurbDetail {
+                        top: points.clone(),
+                        height_m: h.iter().map(|v| v.as_f64().unwrap_or(0.0)).collect(),
+                        measured: vec![!bridged; n],
+                        top_measured: vec![true; n],
+                        class: vec![category.unwrap_or(Category::Curb); n],
+                        bridged,
+                        support_per_m: props
+                            .get("support_per_m")
+                            .and_then(|s| s.as_f64())
+                            .unwrap_or(0.0),
+                    })
+                });
+            toe_edge.push(edge);
             out.push(EdgeLine {
                 points,
                 side,
                 category,
                 method: method.clone(),
                 curb_height_m,
+                detail,
             });
+        }
+    }
+    for (e, k) in out.iter_mut().zip(toe_edge) {
+        let top = k.and_then(|k| tops.remove(&k));
+        match (e.detail.as_mut(), top) {
+            (Some(d), Some(top)) if top.len() == e.points.len() => d.top = top,
+            (Some(_), _) => e.detail = None,
+            _ => {}
         }
     }
     Ok((out, crs))
@@ -267,7 +430,7 @@ pub const SCHEMA_MEMBER: &str = "curbtrace_schema_version";
 /// The schema version this build writes, `(major, minor)`. A minor step only adds optional
 /// members or properties; a major step changes or removes one. Readers take any minor of
 /// their major and refuse a newer major.
-pub const SCHEMA_VERSION: (u32, u32) = (1, 0);
+pub const SCHEMA_VERSION: (u32, u32) = (2, 0);
 
 /// Checks the schema version of a parsed FeatureCollection: none (files from other tools,
 /// reference files) or one of this build's major version passes; a newer major or a
@@ -305,6 +468,7 @@ mod tests {
             category: Some(Category::CurbCut),
             method: Some("bend".into()),
             curb_height_m: Some(0.15),
+            detail: None,
         }];
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("a.geojson");

@@ -443,6 +443,12 @@ pub fn extract_file_with(
         trajectory: &r.trajectory,
     };
     let mut edges = bend::extract_edges(&input, &cfg.bend);
+    crate::curb::annotate(
+        &input,
+        &bend::route::Route::new(&r.trajectory),
+        edges.iter_mut(),
+    );
+    let mut edges = crate::curb::finish(edges);
     for e in &mut edges {
         e.method
             .get_or_insert_with(|| Method::Bend.as_str().to_string());

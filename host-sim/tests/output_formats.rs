@@ -6,10 +6,10 @@
 //! `python3-gdal`), both installed by `scripts/test.sh`: the tests fail when they are missing.
 
 use curbtrace_host_sim::model::{
-    read_geojson, Category, Crs, EdgeLine, Side, SCHEMA_MEMBER, SCHEMA_VERSION,
+    read_geojson, Category, Crs, CurbDetail, EdgeLine, Side, SCHEMA_MEMBER, SCHEMA_VERSION,
 };
 use curbtrace_host_sim::output::format::OutputFormat;
-use curbtrace_host_sim::output::write_edges;
+use curbtrace_host_sim::output::{csv, write_edges};
 use std::path::Path;
 use std::process::Command;
 
@@ -18,7 +18,22 @@ mod common;
 /// WGS 84 / UTM zone 33N in WKT1 with its root EPSG authority.
 const UTM33_WKT: &str = r#"PROJCS["WGS 84 / UTM zone 33N",GEOGCS["WGS 84",DATUM["WGS_1984",SPHEROID["WGS 84",6378137,298.257223563,AUTHORITY["EPSG","7030"]],AUTHORITY["EPSG","6326"]],PRIMEM["Greenwich",0,AUTHORITY["EPSG","8901"]],UNIT["degree",0.0174532925199433,AUTHORITY["EPSG","9122"]],AUTHORITY["EPSG","4326"]],PROJECTION["Transverse_Mercator"],PARAMETER["latitude_of_origin",0],PARAMETER["central_meridian",15],PARAMETER["scale_factor",0.9996],PARAMETER["false_easting",500000],PARAMETER["false_northing",0],UNIT["metre",1,AUTHORITY["EPSG","9001"]],AXIS["Easting",EAST],AXIS["Northing",NORTH],AUTHORITY["EPSG","32633"]]"#;
 
-/// Four edges around (x0, y0): every class once, one without class, method or height.
+/// The top of curb 15 mm behind and `h` above a toe, with the heights and support.
+fn detail(toe: &[[f64; 3]], h: f64, bridged: bool) -> Option<Box<CurbDetail>> {
+    Some(Box::new(CurbDetail {
+        top: toe.iter().map(|p| [p[0] - 0.015, p[1], p[2] + h]).collect(),
+        height_m: vec![h; toe.len()],
+        bridged,
+        support_per_m: if bridged { 0.0 } else { 12.5 },
+        ..CurbDetail::measured(toe)
+    }))
+}
+
+/// Edges with their top lines: the first two of [`edges`], each with a top.
+const WITH_TOP: usize = 2;
+
+/// Four edges around (x0, y0): every class once, one without class, method or height; the
+/// first two with their top of curb (the second bridged).
 fn edges(x0: f64, y0: f64) -> Vec<EdgeLine> {
     let line = |dx: f64, n: usize, z: f64| -> Vec<[f64; 3]> {
         (0..n)
@@ -31,16 +46,19 @@ fn edges(x0: f64, y0: f64) -> Vec<EdgeLine> {
             })
             .collect()
     };
+    let (a, b) = (line(-3.5, 5, 10.0), line(3.5, 3, 10.2));
     vec![
         EdgeLine {
-            points: line(-3.5, 5, 10.0),
+            detail: detail(&a, 0.148, false),
+            points: a,
             side: Side::Left,
             category: Some(Category::Curb),
             method: Some("bend".into()),
             curb_height_m: Some(0.148),
         },
         EdgeLine {
-            points: line(3.5, 3, 10.2),
+            detail: detail(&b, 0.025, true),
+            points: b,
             side: Side::Right,
             category: Some(Category::CurbCut),
             method: Some("bend".into()),
@@ -52,6 +70,7 @@ fn edges(x0: f64, y0: f64) -> Vec<EdgeLine> {
             category: Some(Category::Intersection),
             method: Some("qiu".into()),
             curb_height_m: Some(0.12),
+            detail: None,
         },
         EdgeLine {
             points: line(-6.0, 2, 9.9),
@@ -59,6 +78,7 @@ fn edges(x0: f64, y0: f64) -> Vec<EdgeLine> {
             category: None,
             method: None,
             curb_height_m: None,
+            detail: None,
         },
     ]
 }
@@ -149,7 +169,8 @@ fn every_format_opens_in_gdal_with_its_driver_count_and_crs() {
     ];
     for (tag, crs, x0, y0, srs_mark) in cases {
         let lines = edges(x0, y0);
-        let n = lines.len();
+        // Each edge's toe, and the top of those that have one.
+        let n = lines.len() + WITH_TOP;
         for ext in ["geojson", "csv", "gpkg", "fgb", "dxf"] {
             let path = dir.path().join(format!("edges_{tag}.{ext}"));
             write_edges(&path, &lines, crs.as_ref()).unwrap();
@@ -159,7 +180,8 @@ fn every_format_opens_in_gdal_with_its_driver_count_and_crs() {
                 // Vertex rows, not features: checked by the header and the row count.
                 let text = std::fs::read_to_string(&path).unwrap();
                 let rows = lines.iter().map(|l| l.points.len()).sum::<usize>();
-                assert!(text.starts_with("edge,side,vertex,x,y,z\n"));
+                assert!(text.starts_with(&format!("{}\n", csv::HEADER)));
+                assert!(text.starts_with("edge,side,vertex,x,y,z,"));
                 assert_eq!(text.lines().count(), rows + 1, "{tag}");
                 continue;
             }
@@ -183,6 +205,10 @@ fn every_format_opens_in_gdal_with_its_driver_count_and_crs() {
                 "length_m: Real",
                 "curb_height_m: Real",
                 "category: String",
+                "line: String",
+                "edge: Integer",
+                "bridged: Integer(Boolean)",
+                "support_per_m: Real",
             ] {
                 assert!(info.contains(field), "{tag}.{ext}: {field}:\n{info}");
             }
@@ -244,6 +270,24 @@ fn the_binary_formats_keep_every_property_and_vertex() {
                 assert!(
                     (a - b).abs() < 1e-9,
                     "{ext}: edge {i}: {a} vs {b}:\n{block}"
+                );
+            }
+            let line_kind = block
+                .lines()
+                .find_map(|line| line.trim().strip_prefix("line (String) = "));
+            assert_eq!(line_kind, Some("toe"), "{ext}: edge {i}:\n{block}");
+            if let Some(d) = &l.detail {
+                let top = feature_block(&info, d.top[0])
+                    .unwrap_or_else(|| panic!("{ext}: top of edge {i} not found:\n{info}"));
+                assert!(top.contains("line (String) = top"), "{ext}:\n{top}");
+                assert!(
+                    top.contains(&format!("edge (Integer64) = {i}")),
+                    "{ext}:\n{top}"
+                );
+                let bridged = if d.bridged { "1" } else { "0" };
+                assert!(
+                    top.contains(&format!("bridged (Integer(Boolean)) = {bridged}")),
+                    "{ext}:\n{top}"
                 );
             }
             for (field, value) in props {
@@ -315,6 +359,9 @@ fn dxf_puts_3d_polylines_on_one_layer_per_class_and_names_the_crs() {
         ("TOE_INTERSECTION", 1),
         ("TOE_UNCLASSIFIED", 1),
         ("TOE_BUS_BAY", 0),
+        ("TOP_CURB", 1),
+        ("TOP_CURB_CUT", 1),
+        ("TOP_INTERSECTION", 0),
     ] {
         let w = format!("Layer (String) = {layer}\n");
         assert_eq!(info.matches(&w).count(), count, "{layer}:\n{info}");
@@ -324,6 +371,12 @@ fn dxf_puts_3d_polylines_on_one_layer_per_class_and_names_the_crs() {
         let first = format!("LINESTRING Z ({} {} {},", p[0], p[1], p[2]);
         assert!(info.contains(&first), "{first}:\n{info}");
     }
+    // The bridged stretch's toe and top are dashed, the others continuous (by layer).
+    assert_eq!(
+        info.matches("Linetype (String) = DASHED\n").count(),
+        2,
+        "{info}"
+    );
     let text = std::fs::read_to_string(&path).unwrap();
     let head: Vec<&str> = text.lines().take(4).collect();
     assert_eq!(
@@ -362,7 +415,11 @@ fn writing_over_an_existing_file_replaces_it() {
         let path = dir.path().join(format!("edges.{ext}"));
         write_edges(&path, &edges(0.0, 0.0), None).unwrap();
         write_edges(&path, &edges(0.0, 0.0)[..2], None).unwrap();
-        assert_opens(&path, OutputFormat::from_path(&path).unwrap().name(), 2);
+        assert_opens(
+            &path,
+            OutputFormat::from_path(&path).unwrap().name(),
+            2 + WITH_TOP,
+        );
     }
 }
 
@@ -379,6 +436,27 @@ fn the_geojson_schema_version_round_trips_and_a_newer_major_is_refused() {
     let (back, crs) = read_geojson(&path).unwrap();
     assert_eq!(back.len(), lines.len());
     assert_eq!(crs, Some(Crs::Epsg(6677)));
+    // The top features come back as the detail of their toe: top, heights, support.
+    for (a, b) in lines.iter().zip(&back) {
+        match (&a.detail, &b.detail) {
+            (Some(x), Some(y)) => {
+                // GeoJSON keeps 0.1 mm.
+                let near = |a: f64, b: f64| (a - b).abs() <= 0.6e-4;
+                assert!(x.top.len() == y.top.len(), "{x:?} vs {y:?}");
+                for (p, q) in x.top.iter().zip(&y.top) {
+                    assert!((0..3).all(|k| near(p[k], q[k])), "{p:?} vs {q:?}");
+                }
+                assert!(x
+                    .height_m
+                    .iter()
+                    .zip(&y.height_m)
+                    .all(|(a, b)| near(*a, *b)));
+                assert_eq!((x.bridged, x.support_per_m), (y.bridged, y.support_per_m));
+            }
+            (None, None) => {}
+            other => panic!("detail lost or invented: {other:?}"),
+        }
+    }
 
     // A newer minor of the same major reads; a file without the member (other tools,
     // reference files) reads; a newer major is refused, naming the file and the version.
@@ -468,7 +546,10 @@ fn the_cli_writes_the_format_the_extension_names() {
     let gpkg = dir.path().join("edges.gpkg");
     let (ok, err) = extract(&las, &traj, &["-q", "-o", gpkg.to_str().unwrap()]);
     assert!(ok, "{err}");
-    assert_opens(&gpkg, "GPKG", reference.len());
+    // Every stretch of the bend method has its toe and its top of curb.
+    assert!(reference.iter().all(|e| e.detail.is_some()));
+    let info = assert_opens(&gpkg, "GPKG", 2 * reference.len());
+    assert!(info.contains("line: String"), "{info}");
     // The compatible spelling: --format csv with any file name.
     let txt = dir.path().join("edges.txt");
     let (ok, err) = extract(
@@ -478,5 +559,5 @@ fn the_cli_writes_the_format_the_extension_names() {
     );
     assert!(ok, "{err}");
     let text = std::fs::read_to_string(&txt).unwrap();
-    assert!(text.starts_with("edge,side,vertex,x,y,z\n"), "{text}");
+    assert!(text.starts_with(&format!("{}\n", csv::HEADER)), "{text}");
 }

@@ -363,6 +363,7 @@ fn the_host_has_no_cycle_and_imports_downwards() {
             ("bend", 3),
             ("frame", 3),
             ("qiu", 3),
+            ("curb", 4),
             ("config", 4),
             ("output", 4),
             ("pipeline", 5),

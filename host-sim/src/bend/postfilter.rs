@@ -16,7 +16,7 @@ use super::params::BendParams;
 use super::route::Route;
 use super::track::Track;
 use super::BendInput;
-use crate::model::{Category, EdgeLine};
+use crate::model::{Category, CurbDetail, EdgeLine};
 use crate::replay::PointStatus;
 
 fn pos(input: &BendInput, p: u32) -> [f64; 3] {
@@ -339,6 +339,15 @@ pub fn to_edge_lines_with_steps(
                     category: Some(cat),
                     method: Some("bend".to_string()),
                     curb_height_m: median(&mut st),
+                    // Measured vertices are observed points; virtual ones (ids past the
+                    // points) were placed by the tracker.
+                    detail: Some(Box::new(CurbDetail {
+                        measured: t.points[a..=b]
+                            .iter()
+                            .map(|&p| (p as usize) < input.x.len())
+                            .collect(),
+                        ..CurbDetail::measured(&xyz[a..=b])
+                    })),
                 },
                 steps[a..=b].to_vec(),
             ));

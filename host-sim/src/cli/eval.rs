@@ -3,7 +3,7 @@
 //! `--picture PNG --points LAZ` draws the worst place (longest miss or false edge).
 
 use anyhow::Context;
-use curbtrace_host_sim::eval::{evaluate, worst_place, EvalParams, WorstKind, WorstPlace};
+use curbtrace_host_sim::eval::{evaluate, survey, worst_place, EvalParams, WorstKind, WorstPlace};
 use curbtrace_host_sim::model::{read_geojson, EdgeLine};
 use curbtrace_host_sim::plot::{top_view_png, Cloud, TopView, Window};
 use std::path::{Path, PathBuf};
@@ -67,11 +67,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             args.reference.display()
         )
     })?;
+    let survey = survey(&reference, &extracted, &params)?;
     if let Some(out) = &args.json {
-        std::fs::write(out, report.to_json())
+        let mut v: serde_json::Value = serde_json::from_str(&report.to_json())?;
+        v["survey"] = serde_json::to_value(&survey)?;
+        std::fs::write(out, serde_json::to_string_pretty(&v)?)
             .with_context(|| format!("{}: cannot write", out.display()))?;
     }
     print!("{}", report.to_markdown());
+    print!("{}", survey.to_markdown());
     if let (Some(png), Some(points)) = (&args.picture, &args.points) {
         match worst_place(&reference, &extracted, &params)? {
             Some(w) => {

@@ -80,7 +80,7 @@ pub struct EvalReport {
 
 // ---------------------------------------------------------------------------------------
 // Columns ("buckets"): 0 = total; per side s (0 = left, 1 = right): 1 + 6s = side total,
-// 1 + 6s + 1 + c = category c (0..4 as in Category::ALL, 4 = none).
+// 1 + 6s + 1 + c = category c (0..4 as in Category::REFERENCE, 4 = none).
 
 const N_BUCKETS: usize = 13;
 const N_CAT_SLOTS: usize = 5;
@@ -98,7 +98,7 @@ fn cat_index(c: Option<Category>) -> usize {
         Some(Category::CurbCut) => 1,
         Some(Category::Intersection) => 2,
         Some(Category::BusBay) => 3,
-        None => 4,
+        Some(Category::Flush) | None => 4,
     }
 }
 
@@ -322,7 +322,7 @@ pub fn evaluate(
         let categories = (0..N_CAT_SLOTS)
             .filter(|c| !accs[bs + 1 + c].is_empty())
             .map(|c| CategoryMetrics {
-                category: Category::ALL.get(c).copied(),
+                category: Category::REFERENCE.get(c).copied(),
                 metrics: accs[bs + 1 + c].metrics(),
             })
             .collect();

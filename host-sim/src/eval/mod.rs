@@ -51,11 +51,13 @@ pub mod agreement;
 mod matching;
 mod metrics;
 pub mod report;
+pub mod survey;
 mod table;
 pub mod worst;
 
 pub use agreement::{agreement, Agreement};
 pub use metrics::{evaluate, CategoryMetrics, EvalReport, Metrics, SideMetrics};
+pub use survey::{survey, SurveyReport};
 pub use table::category_title;
 pub use worst::{worst_place, WorstKind, WorstPlace};
 

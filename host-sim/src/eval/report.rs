@@ -333,6 +333,7 @@ mod tests {
             category: cat,
             method: None,
             curb_height_m: None,
+            detail: None,
         }
     }
 

@@ -17,6 +17,7 @@ pub fn category_title(c: Option<Category>) -> &'static str {
         Some(Category::CurbCut) => "Curb cut",
         Some(Category::Intersection) => "Intersection",
         Some(Category::BusBay) => "Bus bay",
+        Some(Category::Flush) => "Flush",
         None => "Other",
     }
 }

@@ -15,6 +15,7 @@ fn line(pts: &[(f64, f64)], side: Side, cat: Option<Category>) -> EdgeLine {
         category: cat,
         method: None,
         curb_height_m: None,
+        detail: None,
     }
 }
 

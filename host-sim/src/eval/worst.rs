@@ -115,6 +115,7 @@ mod tests {
             category: Some(Category::CurbCut),
             method: None,
             curb_height_m: None,
+            detail: None,
         }
     }
 

@@ -1,24 +1,30 @@
-//! Edges as AutoCAD DXF (ASCII, R12): one 3D POLYLINE per edge, in the LAS coordinates,
-//! on one layer per line kind and class (`TOE_CURB`, `TOE_CURB_CUT`, `TOE_INTERSECTION`,
-//! `TOE_BUS_BAY`, `TOE_UNCLASSIFIED`). DXF has no place for a CRS: the file opens with DXF
-//! comment groups (code 999) naming the schema version and the CRS.
+//! Edges as AutoCAD DXF (ASCII, R12): one 3D POLYLINE per line of a stretch (toe and top of
+//! curb), in the LAS coordinates, on one layer per line kind and class (`TOE_CURB`,
+//! `TOP_CURB`, `TOE_CURB_CUT`, …, `TOE_UNCLASSIFIED`); bridged stretches are drawn with the
+//! line type `DASHED`. DXF has no place for a CRS: the file opens with DXF comment groups
+//! (code 999) naming the schema version and the CRS.
 
+use super::features::{features, LineKind};
 use super::format::{OutputError, OutputFormat};
 use crate::model::{Category, Crs, EdgeLine, SCHEMA_MEMBER, SCHEMA_VERSION};
 use dxf::entities::{Entity, EntityType, Polyline, Vertex};
 use dxf::enums::AcadVersion;
-use dxf::tables::Layer;
+use dxf::tables::{Layer, LineType};
 use dxf::{Color, Drawing, Point};
 use std::io::Write;
 use std::path::Path;
 
-/// The line kind of every layer name: the toe of the curb (the top follows later).
-const TOE: &str = "TOE";
+/// The line type of bridged stretches.
+pub const BRIDGED_LINE_TYPE: &str = "DASHED";
 
-/// The layer of an edge: its kind and class, upper case.
-pub fn layer_name(category: Option<Category>) -> String {
+/// The layer of a line: its kind and class, upper case.
+pub fn layer_name(kind: LineKind, category: Option<Category>) -> String {
     let class = category.map_or("unclassified", Category::as_str);
-    format!("{TOE}_{}", class.to_ascii_uppercase())
+    format!(
+        "{}_{}",
+        kind.as_str().to_ascii_uppercase(),
+        class.to_ascii_uppercase()
+    )
 }
 
 /// The AutoCAD colour index of a class's layer.
@@ -28,6 +34,7 @@ fn layer_color(category: Option<Category>) -> u8 {
         Some(Category::CurbCut) => 3,
         Some(Category::Intersection) => 1,
         Some(Category::BusBay) => 5,
+        Some(Category::Flush) => 4,
         None => 8,
     }
 }
@@ -61,22 +68,35 @@ pub fn write_dxf(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<(
     // R12 needs no table handles; the crate writes the tables of R13 and later without the
     // handles those versions require, which CAD programs must then repair.
     drawing.header.version = AcadVersion::R12;
-    let classes = Category::ALL.into_iter().map(Some).chain([None]);
-    for class in classes {
-        drawing.add_layer(Layer {
-            name: layer_name(class),
-            color: Color::from_index(layer_color(class)),
-            ..Default::default()
-        });
+    // Dashes of 0.5 m, gaps of 0.25 m (drawing units: the LAS CRS's, metres).
+    drawing.add_line_type(LineType {
+        name: BRIDGED_LINE_TYPE.into(),
+        description: "Bridged by the tracker __ __ __".into(),
+        element_count: 2,
+        total_pattern_length: 0.75,
+        dash_dot_space_lengths: vec![0.5, -0.25],
+        ..Default::default()
+    });
+    for kind in [LineKind::Toe, LineKind::Top] {
+        for class in Category::ALL.into_iter().map(Some).chain([None]) {
+            drawing.add_layer(Layer {
+                name: layer_name(kind, class),
+                color: Color::from_index(layer_color(class)),
+                ..Default::default()
+            });
+        }
     }
-    for e in edges {
+    for f in features(edges) {
         let mut poly = Polyline::default();
         poly.set_is_3d_polyline(true);
-        for p in &e.points {
+        for p in f.points {
             poly.add_vertex(&mut drawing, Vertex::new(Point::new(p[0], p[1], p[2])));
         }
         let mut entity = Entity::new(EntityType::Polyline(poly));
-        entity.common.layer = layer_name(e.category);
+        entity.common.layer = layer_name(f.kind, f.stretch.category);
+        if f.bridged() == Some(true) {
+            entity.common.line_type_name = BRIDGED_LINE_TYPE.into();
+        }
         drawing.add_entity(entity);
     }
     let mut body = Vec::new();
@@ -97,9 +117,15 @@ mod tests {
 
     #[test]
     fn layers_are_kind_and_class_in_upper_case() {
-        assert_eq!(layer_name(Some(Category::CurbCut)), "TOE_CURB_CUT");
-        assert_eq!(layer_name(Some(Category::BusBay)), "TOE_BUS_BAY");
-        assert_eq!(layer_name(None), "TOE_UNCLASSIFIED");
+        assert_eq!(
+            layer_name(LineKind::Toe, Some(Category::CurbCut)),
+            "TOE_CURB_CUT"
+        );
+        assert_eq!(
+            layer_name(LineKind::Top, Some(Category::BusBay)),
+            "TOP_BUS_BAY"
+        );
+        assert_eq!(layer_name(LineKind::Toe, None), "TOE_UNCLASSIFIED");
     }
 
     #[test]

@@ -1,7 +1,9 @@
-//! Edges as FlatGeobuf: one layer `edges` of LineString Z features with a packed Hilbert
+//! Edges as FlatGeobuf: one layer `edges` of LineString Z features (toe and top lines,
+//! told apart by `line`) with a packed Hilbert
 //! R-tree (none when there are no edges), the LAS CRS in the header (EPSG code, and the WKT when the LAS gives one),
 //! written by the `flatgeobuf` crate.
 
+use super::features::features;
 use super::format::{OutputError, OutputFormat};
 use crate::model::{Crs, EdgeLine, SCHEMA_MEMBER, SCHEMA_VERSION};
 use flatgeobuf::geozero::{ColumnValue, FeatureProcessor, GeomProcessor, PropertyProcessor};
@@ -13,12 +15,16 @@ use std::path::Path;
 pub const LAYER: &str = "edges";
 
 /// The attribute columns, in file order.
-const COLUMNS: [(&str, ColumnType, bool); 5] = [
+const COLUMNS: [(&str, ColumnType, bool); 9] = [
     ("side", ColumnType::String, false),
     ("method", ColumnType::String, true),
     ("length_m", ColumnType::Double, false),
     ("curb_height_m", ColumnType::Double, true),
     ("category", ColumnType::String, true),
+    ("line", ColumnType::String, false),
+    ("edge", ColumnType::Long, false),
+    ("bridged", ColumnType::Bool, true),
+    ("support_per_m", ColumnType::Double, true),
 ];
 
 /// Writes `edges` as FlatGeobuf at `path`, replacing any file there.
@@ -57,21 +63,26 @@ pub fn write_fgb(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<(
     for (name, ty, nullable) in COLUMNS {
         fgb.add_column(name, ty, |_, col| col.nullable = nullable);
     }
-    for (i, e) in edges.iter().enumerate() {
+    for (i, f) in features(edges).iter().enumerate() {
+        let e = f.stretch;
         let props = [
             Some(ColumnValue::String(e.side.as_str())),
             e.method.as_deref().map(ColumnValue::String),
-            Some(ColumnValue::Double(e.length_m())),
+            Some(ColumnValue::Double(f.length_m())),
             e.curb_height_m.map(ColumnValue::Double),
             e.category.map(|c| ColumnValue::String(c.as_str())),
+            Some(ColumnValue::String(f.kind.as_str())),
+            Some(ColumnValue::Long(f.edge as i64)),
+            f.bridged().map(ColumnValue::Bool),
+            f.support_per_m().map(ColumnValue::Double),
         ];
         for (k, value) in props.iter().enumerate() {
             if let Some(v) = value {
                 fgb.property(k, COLUMNS[k].0, v).map_err(enc)?;
             }
         }
-        fgb.linestring_begin(true, e.points.len(), 0).map_err(enc)?;
-        for (j, p) in e.points.iter().enumerate() {
+        fgb.linestring_begin(true, f.points.len(), 0).map_err(enc)?;
+        for (j, p) in f.points.iter().enumerate() {
             fgb.coordinate(p[0], p[1], Some(p[2]), None, None, None, j)
                 .map_err(enc)?;
         }

@@ -1,13 +1,16 @@
 //! Edges as a GeoJSON FeatureCollection with the legacy `crs` member (docs/spec.md §3).
 
+use super::features::{features, LineKind};
 use crate::model::{Crs, EdgeLine, GeoJsonError, SCHEMA_MEMBER, SCHEMA_VERSION};
 
-/// Serialises lines as a GeoJSON FeatureCollection with the legacy `crs` member.
+/// Serialises lines as a GeoJSON FeatureCollection with the legacy `crs` member: per
+/// stretch its toe feature and, where surveyed, its top feature (`line`, `edge`).
 pub fn lines_to_geojson(lines: &[EdgeLine], crs: Option<&Crs>) -> serde_json::Value {
     use serde_json::{json, Map, Value};
-    let features: Vec<Value> = lines
+    let features: Vec<Value> = features(lines)
         .iter()
-        .map(|l| {
+        .map(|f| {
+            let l = f.stretch;
             let mut props = Map::new();
             props.insert("side".into(), json!(l.side.as_str()));
             if let Some(c) = l.category {
@@ -16,11 +19,27 @@ pub fn lines_to_geojson(lines: &[EdgeLine], crs: Option<&Crs>) -> serde_json::Va
             if let Some(m) = &l.method {
                 props.insert("method".into(), json!(m));
             }
-            props.insert("length_m".into(), json!(round_to(l.length_m(), 1e-3)));
+            props.insert("length_m".into(), json!(round_to(f.length_m(), 1e-3)));
             if let Some(h) = l.curb_height_m {
                 props.insert("curb_height_m".into(), json!(round_to(h, 1e-4)));
             }
-            let coords: Vec<Value> = l
+            if let Some(d) = &l.detail {
+                props.insert("line".into(), json!(f.kind.as_str()));
+                props.insert("edge".into(), json!(f.edge));
+                // Reference lines (no method) are not extracted: no support to tell.
+                if l.method.is_some() {
+                    props.insert("bridged".into(), json!(d.bridged));
+                    props.insert(
+                        "support_per_m".into(),
+                        json!(round_to(d.support_per_m, 1e-2)),
+                    );
+                }
+                if f.kind == LineKind::Toe {
+                    let hs: Vec<f64> = d.height_m.iter().map(|&h| round_to(h, 1e-4)).collect();
+                    props.insert("heights_m".into(), json!(hs));
+                }
+            }
+            let coords: Vec<Value> = f
                 .points
                 .iter()
                 .map(|p| {
@@ -58,8 +77,11 @@ pub fn lines_to_geojson(lines: &[EdgeLine], crs: Option<&Crs>) -> serde_json::Va
     Value::Object(fc)
 }
 
+/// `v` rounded to a multiple of `step` (a power of ten), dividing by the integer `1 / step`
+/// so that the result is the nearest `f64` to the decimal (0.148, not 0.14800000000000002).
 fn round_to(v: f64, step: f64) -> f64 {
-    (v / step).round() * step
+    let inv = (1.0 / step).round();
+    (v * inv).round() / inv
 }
 
 /// Writes lines to a GeoJSON file.

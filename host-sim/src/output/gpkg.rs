@@ -5,6 +5,7 @@
 //! Geometries are GeoPackage binary blobs: the `GP` header with the srs id and the XY
 //! envelope, then ISO WKB LineString Z, encoded by geozero's GeoPackage WKB dialect.
 
+use super::features::features;
 use super::format::{OutputError, OutputFormat};
 use crate::model::{Crs, EdgeLine, SCHEMA_MEMBER, SCHEMA_VERSION};
 use geozero::wkb::{WkbDialect, WkbWriter};
@@ -67,7 +68,11 @@ CREATE TABLE edges (
   method TEXT,
   length_m DOUBLE,
   curb_height_m DOUBLE,
-  category TEXT
+  category TEXT,
+  line TEXT NOT NULL,
+  edge INTEGER NOT NULL,
+  bridged BOOLEAN,
+  support_per_m DOUBLE
 );
 ";
 
@@ -117,9 +122,9 @@ fn wkt_name(wkt: &str) -> Option<String> {
 
 /// The GeoPackage geometry blob of a line: header with srs id and XY envelope, ISO WKB
 /// LineString Z.
-fn geometry_blob(line: &EdgeLine, srs_id: i32) -> geozero::error::Result<Vec<u8>> {
-    let (min, max) = envelope(std::slice::from_ref(line));
-    let mut blob = Vec::with_capacity(48 + 9 + 24 * line.points.len());
+fn geometry_blob(points: &[[f64; 3]], srs_id: i32) -> geozero::error::Result<Vec<u8>> {
+    let (min, max) = envelope(points.iter());
+    let mut blob = Vec::with_capacity(48 + 9 + 24 * points.len());
     let mut w = WkbWriter::with_opts(
         &mut blob,
         WkbDialect::Geopackage,
@@ -127,19 +132,19 @@ fn geometry_blob(line: &EdgeLine, srs_id: i32) -> geozero::error::Result<Vec<u8>
         Some(srs_id),
         vec![min[0], max[0], min[1], max[1]],
     );
-    w.linestring_begin(true, line.points.len(), 0)?;
-    for (i, p) in line.points.iter().enumerate() {
+    w.linestring_begin(true, points.len(), 0)?;
+    for (i, p) in points.iter().enumerate() {
         w.coordinate(p[0], p[1], Some(p[2]), None, None, None, i)?;
     }
     w.linestring_end(true, 0)?;
     Ok(blob)
 }
 
-/// XY bounds `(min, max)` of all vertices; `(+inf, -inf)` when there are none.
-pub(crate) fn envelope(lines: &[EdgeLine]) -> ([f64; 2], [f64; 2]) {
+/// XY bounds `(min, max)` of the vertices; `(+inf, -inf)` when there are none.
+pub(crate) fn envelope<'a>(points: impl Iterator<Item = &'a [f64; 3]>) -> ([f64; 2], [f64; 2]) {
     let mut min = [f64::INFINITY; 2];
     let mut max = [f64::NEG_INFINITY; 2];
-    for p in lines.iter().flat_map(|l| &l.points) {
+    for p in points {
         for k in 0..2 {
             min[k] = min[k].min(p[k]);
             max[k] = max[k].max(p[k]);
@@ -205,7 +210,8 @@ pub fn write_gpkg(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<
         )
         .map_err(sql)?;
     }
-    let (min, max) = envelope(edges);
+    let feats = features(edges);
+    let (min, max) = envelope(feats.iter().flat_map(|f| f.points));
     let bounds = |v: f64| v.is_finite().then_some(v);
     tx.execute(
         "INSERT INTO gpkg_contents \
@@ -235,21 +241,27 @@ pub fn write_gpkg(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<
     {
         let mut insert = tx
             .prepare(
-                "INSERT INTO edges (geom, side, method, length_m, curb_height_m, category) \
-                 VALUES (?1, ?2, ?3, ?4, ?5, ?6)",
+                "INSERT INTO edges (geom, side, method, length_m, curb_height_m, category, \
+                 line, edge, bridged, support_per_m) \
+                 VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)",
             )
             .map_err(sql)?;
-        for e in edges {
-            let blob = geometry_blob(e, srs_id)
+        for f in &feats {
+            let e = f.stretch;
+            let blob = geometry_blob(f.points, srs_id)
                 .map_err(|err| OutputError::encode(path, OutputFormat::GeoPackage, err))?;
             insert
                 .execute(params![
                     blob,
                     e.side.as_str(),
                     e.method,
-                    e.length_m(),
+                    f.length_m(),
                     e.curb_height_m,
                     e.category.map(|c| c.as_str()),
+                    f.kind.as_str(),
+                    f.edge as i64,
+                    f.bridged(),
+                    f.support_per_m(),
                 ])
                 .map_err(sql)?;
         }
@@ -261,18 +273,10 @@ pub fn write_gpkg(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Side;
 
     #[test]
     fn the_geometry_blob_is_a_gpkg_header_and_iso_wkb_linestring_z() {
-        let line = EdgeLine {
-            points: vec![[1.0, 2.0, 3.0], [4.0, -5.0, 6.0]],
-            side: Side::Left,
-            category: None,
-            method: None,
-            curb_height_m: None,
-        };
-        let b = geometry_blob(&line, 6677).unwrap();
+        let b = geometry_blob(&[[1.0, 2.0, 3.0], [4.0, -5.0, 6.0]], 6677).unwrap();
         assert_eq!(&b[..3], b"GP\0");
         // Flags: little endian, XY envelope (envelope code 1).
         assert_eq!(b[3], 0b0000_0011);

@@ -3,6 +3,7 @@
 
 pub mod csv;
 pub mod dxf;
+pub mod features;
 pub mod fgb;
 pub mod format;
 pub mod geojson;

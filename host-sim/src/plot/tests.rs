@@ -53,6 +53,7 @@ fn windows_of_interest_find_categories_and_the_occlusion() {
         category: Some(cat),
         method: None,
         curb_height_m: None,
+        detail: None,
     };
     let refs = vec![
         l(&[(0.0, 5.0), (40.0, 5.0)], Side::Left, Category::Curb),
@@ -169,6 +170,7 @@ fn street() -> Street {
         category: cat,
         method: method.map(str::to_string),
         curb_height_m: None,
+        detail: None,
     };
     let refs = vec![
         l(4.0, Side::Left, Some(Category::Curb), None),

@@ -3,7 +3,7 @@
 
 use super::style::*;
 use super::{draw_err, draw_legend, input_err, register_font, PlotError, FONT_NAME};
-use crate::model::EdgeLine;
+use crate::model::{Category, EdgeLine};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -371,22 +371,77 @@ pub fn top_view_png(path: &Path, view: &TopView) -> Result<TopViewStats, PlotErr
             .label("reference")
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], ref_style));
     }
-    let ext_style = ShapeStyle {
-        color: BLACK.to_rgba(),
+    // Extracted toes: colour by class, solid where measured, dashed where bridged; the top
+    // of curb beside them as a thin blue line.
+    let dash = 12.0 / px_per_m; // 12 px dashes
+    let top_style = ShapeStyle {
+        color: RGBColor(30, 110, 220).to_rgba(),
         filled: false,
-        stroke_width: 2,
+        stroke_width: 1,
     };
-    if !view.extracted.is_empty() {
+    let tops: Vec<Vec<(f64, f64)>> = view
+        .extracted
+        .iter()
+        .filter_map(|l| l.detail.as_ref())
+        .flat_map(|d| {
+            let v: Vec<(f64, f64)> = d.top.iter().map(|p| (p[0] - ox, p[1] - oy)).collect();
+            clip_polyline(&v, rect)
+        })
+        .collect();
+    if !tops.is_empty() {
         chart
-            .draw_series(
-                view.extracted
-                    .iter()
-                    .flat_map(local)
-                    .map(|v| PathElement::new(v, ext_style)),
-            )
+            .draw_series(tops.into_iter().map(|v| PathElement::new(v, top_style)))
             .map_err(&err)?
-            .label("extracted")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], ext_style));
+            .label("top of curb")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], top_style));
+    }
+    let bridged = |l: &EdgeLine| l.detail.as_ref().is_some_and(|d| d.bridged);
+    for class in Category::ALL.map(Some).into_iter().chain([None]) {
+        let lines: Vec<&EdgeLine> = view
+            .extracted
+            .iter()
+            .filter(|l| l.category == class || (class.is_none() && l.detail.is_none()))
+            .filter(|l| class.is_none() || l.detail.is_some())
+            .collect();
+        if lines.is_empty() {
+            continue;
+        }
+        let style = ShapeStyle {
+            color: class_colour(class).to_rgba(),
+            filled: false,
+            stroke_width: 2,
+        };
+        let mut paths: Vec<Vec<(f64, f64)>> = Vec::new();
+        for l in lines {
+            if bridged(l) {
+                let v: Vec<(f64, f64)> = l.points.iter().map(|p| (p[0] - ox, p[1] - oy)).collect();
+                paths.extend(dashes(&v, dash).iter().flat_map(|d| clip_polyline(d, rect)));
+            } else {
+                paths.extend(local(l));
+            }
+        }
+        let label = match class {
+            Some(c) => format!("toe: {}", c.as_str()),
+            None => "extracted".to_string(),
+        };
+        chart
+            .draw_series(paths.into_iter().map(|v| PathElement::new(v, style)))
+            .map_err(&err)?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], style));
+    }
+    if view.extracted.iter().any(bridged) {
+        let style = ShapeStyle {
+            color: BLACK.to_rgba(),
+            filled: false,
+            stroke_width: 2,
+        };
+        // A legend entry only: bridged stretches are the dashed ones.
+        chart
+            .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+            .map_err(&err)?
+            .label("bridged (dashed)")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], style));
     }
     if view.trajectory.len() >= 2 {
         let t: Vec<(f64, f64)> = view
@@ -399,7 +454,6 @@ pub fn top_view_png(path: &Path, view: &TopView) -> Result<TopViewStats, PlotErr
             filled: false,
             stroke_width: 2,
         };
-        let dash = 12.0 / px_per_m; // 12 px dashes
         chart
             .draw_series(
                 dashes(&t, dash)
@@ -425,6 +479,17 @@ pub fn top_view_png(path: &Path, view: &TopView) -> Result<TopViewStats, PlotErr
         size_px: (w_px, h_px),
         z_range_m: z_range,
     })
+}
+
+/// The colour of an extracted toe of class `c` (black where unclassified or plain curb).
+fn class_colour(c: Option<Category>) -> RGBColor {
+    match c {
+        Some(Category::Curb) | None => RGBColor(0, 0, 0),
+        Some(Category::CurbCut) => RGBColor(0, 150, 60),
+        Some(Category::Intersection) => RGBColor(170, 0, 170),
+        Some(Category::BusBay) => RGBColor(0, 170, 190),
+        Some(Category::Flush) => RGBColor(150, 100, 0),
+    }
 }
 
 /// The extent of the whole scene: reference, extracted and trajectory, widened to the

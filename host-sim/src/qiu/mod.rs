@@ -162,6 +162,7 @@ pub fn extract_edges_with_report(
                 category,
                 method: Some("qiu".into()),
                 curb_height_m,
+                detail: None,
             }
         })
         .collect();

@@ -160,7 +160,7 @@ pub struct SimSummary {
     pub length_m: f64,
     /// Scan duration, seconds.
     pub duration_s: f64,
-    /// Reference length per category, metres, in [`Category::ALL`] order.
+    /// Reference length per category, metres, in [`Category::REFERENCE`] order.
     pub reference_m: [f64; 4],
     /// Wall-clock seconds for the whole run.
     pub elapsed_s: f64,
@@ -287,7 +287,10 @@ pub fn run(
     let mut reference_m = [0.0; 4];
     for l in &sim.reference {
         if let Some(c) = l.category {
-            let i = Category::ALL.iter().position(|&x| x == c).unwrap_or(0);
+            let i = Category::REFERENCE
+                .iter()
+                .position(|&x| x == c)
+                .unwrap_or(0);
             reference_m[i] += l.length_m();
         }
     }

@@ -17,9 +17,10 @@
 //! side street's curbs. The side is the sign of the segment midpoint's lateral offset x′
 //! from the nearest trajectory sample (docs/spec.md §2: left positive).
 
+use super::ground::ToeLine;
 use super::ground::{Ground, ToeCoord};
 use crate::io::trajectory::Trajectory;
-use crate::model::{Category, EdgeLine, Side};
+use crate::model::{Category, CurbDetail, EdgeLine, Side};
 
 /// Half window along the toe, metres.
 pub const WINDOW_M: f64 = 0.15;
@@ -96,7 +97,28 @@ impl Visibility {
     }
 }
 
-/// Builds the reference lines (CRS coordinates: local + `origin`).
+/// The true top of curb beside toe vertex `i` at `toe_xyz` (CRS coordinates): the corner
+/// of the face and the top (docs/spec.md §2, "Curb geometry"), the face's batter run
+/// behind the toe and the curb height above it; the toe itself where there is no lip.
+fn top_of_curb(ground: &Ground, toe: &ToeLine, i: usize, toe_xyz: [f64; 3]) -> [f64; 3] {
+    let hc = toe.h_curb[i].max(0.0);
+    let (a, b) = (i.saturating_sub(1), (i + 1).min(toe.pts.len() - 1));
+    let d = [toe.pts[b][0] - toe.pts[a][0], toe.pts[b][1] - toe.pts[a][1]];
+    let l = d[0].hypot(d[1]);
+    if l <= 0.0 {
+        return [toe_xyz[0], toe_xyz[1], toe_xyz[2] + hc];
+    }
+    // The sidewalk lies left of the toe's direction (`ground::ToeLine`).
+    let run = ground.shape.batter_ratio * hc;
+    [
+        toe_xyz[0] - run * d[1] / l,
+        toe_xyz[1] + run * d[0] / l,
+        toe_xyz[2] + hc,
+    ]
+}
+
+/// Builds the reference lines (CRS coordinates: local + `origin`), each with its true top
+/// of curb and curb height per vertex in its [`CurbDetail`].
 pub fn reference_lines(
     ground: &Ground,
     vis: &Visibility,
@@ -128,23 +150,35 @@ pub fn reference_lines(
             if let Some((side, cat, idx)) = cur.take() {
                 if idx.len() >= 2 {
                     let mut hs: Vec<f64> = idx.iter().map(|&i| toe.h_curb[i]).collect();
+                    let heights = hs.clone();
                     hs.sort_by(f64::total_cmp);
+                    let points: Vec<[f64; 3]> = idx
+                        .iter()
+                        .map(|&i| {
+                            let p = toe.pts[i];
+                            [
+                                p[0] + origin[0],
+                                p[1] + origin[1],
+                                ground.base.at(p[0], p[1]) + origin[2],
+                            ]
+                        })
+                        .collect();
+                    let top = idx
+                        .iter()
+                        .zip(&points)
+                        .map(|(&i, p)| top_of_curb(ground, toe, i, *p))
+                        .collect();
                     out.push(EdgeLine {
-                        points: idx
-                            .iter()
-                            .map(|&i| {
-                                let p = toe.pts[i];
-                                [
-                                    p[0] + origin[0],
-                                    p[1] + origin[1],
-                                    ground.base.at(p[0], p[1]) + origin[2],
-                                ]
-                            })
-                            .collect(),
                         side,
                         category: Some(cat),
                         method: None,
                         curb_height_m: Some(hs[hs.len() / 2]),
+                        detail: Some(Box::new(CurbDetail {
+                            top,
+                            height_m: heights,
+                            ..CurbDetail::measured(&points)
+                        })),
+                        points,
                     });
                 }
             }

@@ -131,15 +131,10 @@ impl Merge {
 
 /// `a` continued by `b`: the vertices and height samples of both.
 fn join(a: &Piece, b: &Piece) -> Piece {
-    let mut points = a.line.points.clone();
-    points.extend_from_slice(&b.line.points);
     let mut steps = a.steps.clone();
     steps.extend_from_slice(&b.steps);
     Piece {
-        line: EdgeLine {
-            points,
-            ..b.line.clone()
-        },
+        line: a.line.joined(&b.line),
         steps,
         open_start: a.open_start,
         open_end: b.open_end,
@@ -163,6 +158,7 @@ mod tests {
             category: None,
             method: None,
             curb_height_m: Some(0.1),
+            detail: None,
         }
     }
 

@@ -124,6 +124,8 @@ pub fn extract(
             read as usize,
         )));
     }
+    // The closed edges, cut into stretches of one class and one kind of support.
+    pass.edges = crate::curb::finish(std::mem::take(&mut pass.edges));
     for e in &mut pass.edges {
         e.method
             .get_or_insert_with(|| Method::Bend.as_str().to_string());

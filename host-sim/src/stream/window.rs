@@ -19,6 +19,7 @@ use super::core_stage::CoreBatch;
 use super::merge::{Merge, Piece};
 use crate::bend::route::Route;
 use crate::bend::{self, BendInput, BendParams};
+use crate::curb;
 use crate::io::trajectory::Trajectory;
 use crate::model::EdgeLine;
 use crate::replay::{Candidate, PointStatus};
@@ -290,7 +291,9 @@ impl<'a> SectionWindow<'a> {
             candidates: &cands,
             trajectory: self.traj,
         };
-        bend::extract_edges_on_route(&input, &self.route, &self.bend)
+        let mut edges = bend::extract_edges_on_route(&input, &self.route, &self.bend);
+        curb::annotate(&input, &self.route, edges.iter_mut().map(|(e, _)| e));
+        edges
     }
 }
 
@@ -323,10 +326,7 @@ fn cut_to_section(
             k += 1;
         }
         out.push(Piece::cut(
-            EdgeLine {
-                points: e.points[a..k].to_vec(),
-                ..e.clone()
-            },
+            e.sub(a, k),
             steps[a..k].to_vec(),
             a > 0,
             k < st.len(),

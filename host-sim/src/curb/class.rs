@@ -1,0 +1,255 @@
+//! The class of every toe vertex and the stretches of one class (docs/spec.md §2,
+//! "Classes"): `intersection` where the edge turns away from the route, `bus_bay` where it
+//! stands out from the line of its side's curb, then by height `curb` or `curb_cut`, and
+//! `flush` for a low run longer than any curb cut.
+
+use super::tangent;
+use crate::bend::route::Route;
+use crate::model::{Category, CurbDetail, EdgeLine, Side};
+
+/// Angle between the edge and the route above which a vertex is on an intersection
+/// (corner arc or side street), degrees.
+pub const TURN_DEG: f64 = 30.0;
+/// How much wider than usual the road is at a bus bay or setback, metres.
+pub const BAY_MIN_M: f64 = 0.5;
+/// How far a vertex with no curb on the other side stands out from its side's usual
+/// offset to be on a bus bay, metres: the bay's threshold plus a lane's slack for the
+/// vehicle's wander.
+pub const BAY_ALONE_M: f64 = 1.2;
+/// Reach along the route within which the other side's curb counts as beside a vertex,
+/// metres.
+pub const PAIR_M: f64 = 1.0;
+/// Highest curb at a curb cut (a lowered curb's lip, a ramp), metres.
+pub const CUT_MAX_M: f64 = 0.05;
+/// Shortest low run that is a flush edge rather than a curb cut, metres (curb cuts for
+/// driveways and crossings are up to about 15 m with their transitions).
+pub const FLUSH_MIN_M: f64 = 20.0;
+/// Shortest stretch of one class; shorter runs join their neighbour.
+pub const MIN_RUN_M: f64 = 1.0;
+/// Share of the vertices (not turned) taken as the usual width or offset: the value below
+/// which this share lies.
+const LINE_QUANTILE: f64 = 0.2;
+
+/// Sets the class of every vertex of `edges` (those with detail), from their heights, their
+/// direction against the route and how far they stand out from the curb line.
+///
+/// The vehicle wanders in its lane, so a curb's offset from the route alone moves by as
+/// much as a lane's slack; the road's width does not. Where the other side's curb runs
+/// beside a vertex (within [`PAIR_M`] of its station), the vertex stands out by the width
+/// there minus the usual width; elsewhere by its offset minus its side's usual offset,
+/// against a threshold that allows for the wander.
+pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
+    // Per vertex: (turned, offset from the route, station).
+    let geo: Vec<Vec<(bool, f64, f64)>> = edges
+        .iter()
+        .map(|e| {
+            (0..e.points.len())
+                .map(|k| {
+                    let p = e.points[k];
+                    match (tangent(&e.points, k, 0.5), route.nearest(p[0], p[1])) {
+                        (Some(t), Some((q, f))) => {
+                            let c = (t[0] * f[0] + t[1] * f[1]).abs().min(1.0);
+                            (
+                                c.acos().to_degrees() > TURN_DEG,
+                                (p[0] - q[0]).hypot(p[1] - q[1]),
+                                route.station_near(p[0], p[1]).unwrap_or(f64::NAN),
+                            )
+                        }
+                        _ => (false, f64::NAN, f64::NAN),
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    // Vertices running along the route, per side, by station: (station, offset).
+    let mut along: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
+    for (e, g) in edges.iter().zip(&geo) {
+        let s = usize::from(e.side == Side::Right);
+        along[s].extend(
+            g.iter()
+                .filter(|g| !g.0 && g.1.is_finite() && g.2.is_finite())
+                .map(|g| (g.2, g.1)),
+        );
+    }
+    for a in along.iter_mut() {
+        a.sort_unstable_by(|p, q| p.0.total_cmp(&q.0));
+    }
+    // The other side's offset at `station`: the median within PAIR_M.
+    let beside = |side: usize, station: f64| -> Option<f64> {
+        let a = &along[1 - side];
+        let lo = a.partition_point(|p| p.0 < station - PAIR_M);
+        let hi = a.partition_point(|p| p.0 <= station + PAIR_M);
+        let mut v: Vec<f64> = a[lo..hi].iter().map(|p| p.1).collect();
+        super::median(&mut v)
+    };
+    let quantile = |mut v: Vec<f64>| -> Option<f64> {
+        if v.is_empty() {
+            return None;
+        }
+        v.sort_unstable_by(f64::total_cmp);
+        Some(v[((v.len() - 1) as f64 * LINE_QUANTILE) as usize])
+    };
+    let width_line = quantile(
+        along[0]
+            .iter()
+            .filter_map(|&(st, off)| beside(0, st).map(|o| o + off))
+            .collect(),
+    );
+    let side_line = [
+        quantile(along[0].iter().map(|p| p.1).collect()),
+        quantile(along[1].iter().map(|p| p.1).collect()),
+    ];
+    for (e, g) in edges.iter_mut().zip(&geo) {
+        let side = usize::from(e.side == Side::Right);
+        let Some(d) = e.detail.as_mut() else { continue };
+        d.class = g
+            .iter()
+            .zip(&d.height_m)
+            .map(|(&(turned, off, station), &h)| {
+                let stand_out = |o: f64, s: usize| side_line[s].map_or(0.0, |l| o - l);
+                let out_by = match (beside(side, station), width_line) {
+                    // The wider road is this side's bay when this side's curb stands out
+                    // more than the other's.
+                    (Some(o), Some(w)) if stand_out(off, side) >= stand_out(o, 1 - side) => {
+                        off + o - w - BAY_MIN_M
+                    }
+                    (Some(_), Some(_)) => f64::NEG_INFINITY,
+                    _ => side_line[side].map_or(f64::NEG_INFINITY, |l| off - l - BAY_ALONE_M),
+                };
+                if turned {
+                    Category::Intersection
+                } else if out_by > 0.0 {
+                    Category::BusBay
+                } else if h < CUT_MAX_M {
+                    Category::CurbCut
+                } else {
+                    Category::Curb
+                }
+            })
+            .collect();
+    }
+}
+
+/// Arc length at each vertex.
+fn arc(pts: &[[f64; 3]]) -> Vec<f64> {
+    let mut s = vec![0.0; pts.len()];
+    for k in 1..pts.len() {
+        s[k] = s[k - 1] + (pts[k][0] - pts[k - 1][0]).hypot(pts[k][1] - pts[k - 1][1]);
+    }
+    s
+}
+
+/// Turns runs of curb-cut vertices longer than [`FLUSH_MIN_M`] into flush ones (on the
+/// closed edge, where the whole run is known).
+pub fn flush_runs(pts: &[[f64; 3]], d: &mut CurbDetail) {
+    let s = arc(pts);
+    let m = d.class.len().min(pts.len());
+    let mut k = 0;
+    while k < m {
+        if d.class[k] != Category::CurbCut {
+            k += 1;
+            continue;
+        }
+        let a = k;
+        while k < m && d.class[k] == Category::CurbCut {
+            k += 1;
+        }
+        if s[k - 1] - s[a] >= FLUSH_MIN_M {
+            d.class[a..k].fill(Category::Flush);
+        }
+    }
+}
+
+/// Runs `(first, last, class)` of equal class over the vertices (consecutive runs share
+/// their boundary vertex); runs shorter than `min_run_m` join the neighbour before them
+/// (or after, for the first run), shortest first.
+pub fn smoothed_runs(
+    pts: &[[f64; 3]],
+    class: &[Category],
+    min_run_m: f64,
+) -> Vec<(usize, usize, Category)> {
+    let m = pts.len().min(class.len());
+    if m == 0 {
+        return Vec::new();
+    }
+    let s = arc(pts);
+    let mut runs: Vec<(usize, usize, Category)> = Vec::new();
+    for (k, &c) in class[..m].iter().enumerate() {
+        match runs.last_mut() {
+            Some(r) if r.2 == c => r.1 = k,
+            Some(r) => {
+                r.1 = k;
+                runs.push((k, k, c));
+            }
+            None => runs.push((k, k, c)),
+        }
+    }
+    if runs.len() > 1 && runs.last().is_some_and(|r| r.0 == r.1) {
+        runs.pop();
+        if let Some(r) = runs.last_mut() {
+            r.1 = m - 1;
+        }
+    }
+    while runs.len() > 1 {
+        let Some((k, _)) = runs
+            .iter()
+            .enumerate()
+            .map(|(k, r)| (k, s[r.1] - s[r.0]))
+            .filter(|&(_, l)| l < min_run_m)
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+        else {
+            break;
+        };
+        if k == 0 {
+            runs[1].0 = runs[0].0;
+            runs.remove(0);
+        } else {
+            runs[k - 1].1 = runs[k].1;
+            runs.remove(k);
+        }
+        let mut merged: Vec<(usize, usize, Category)> = Vec::new();
+        for r in runs.drain(..) {
+            match merged.last_mut() {
+                Some(q) if q.2 == r.2 => q.1 = r.1,
+                _ => merged.push(r),
+            }
+        }
+        runs = merged;
+    }
+    runs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pts(n: usize, step: f64) -> Vec<[f64; 3]> {
+        (0..n).map(|i| [i as f64 * step, 0.0, 0.0]).collect()
+    }
+
+    #[test]
+    fn short_runs_join_their_neighbours_and_runs_cover_every_vertex() {
+        let p = pts(101, 0.1);
+        let mut c = vec![Category::Curb; 101];
+        c[40..43].fill(Category::CurbCut); // 0.2 m: absorbed
+        c[60..95].fill(Category::CurbCut); // 3.4 m: kept
+        let runs = smoothed_runs(&p, &c, 1.0);
+        // The last 0.5 m of curb is too short for a stretch of its own.
+        assert_eq!(
+            runs,
+            vec![(0, 60, Category::Curb), (60, 100, Category::CurbCut)]
+        );
+    }
+
+    #[test]
+    fn a_long_low_run_is_flush_and_a_short_one_a_curb_cut() {
+        let p = pts(401, 0.1);
+        let mut d = CurbDetail::measured(&p);
+        d.class[0..250].fill(Category::CurbCut); // 24.9 m
+        d.class[300..380].fill(Category::CurbCut); // 7.9 m
+        flush_runs(&p, &mut d);
+        assert_eq!(d.class[10], Category::Flush);
+        assert_eq!(d.class[320], Category::CurbCut);
+        assert_eq!(d.class[260], Category::Curb);
+    }
+}
