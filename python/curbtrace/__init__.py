@@ -126,6 +126,25 @@ def _select_scanner(channel: Optional[np.ndarray], source_id: Optional[np.ndarra
     return source_id == scanner
 
 
+def _las_crs(header: Any) -> tuple:
+    """The CRS as the file reader keeps it: the WKT VLR's text as it is, else the EPSG code
+    of the GeoTIFF keys (read through pyproj)."""
+    for v in getattr(header, "vlrs", []):
+        text = getattr(v, "string", None)
+        if isinstance(text, (bytes, str)) and "WktCoordinateSystem" in type(v).__name__:
+            if isinstance(text, bytes):
+                text = text.decode("utf-8", "replace")
+            return None, text.rstrip("\0").strip()
+    try:
+        crs = header.parse_crs()
+    except Exception:  # pyproj missing or keys it cannot read: the output has no CRS
+        crs = None
+    if crs is None:
+        return None, None
+    epsg = crs.to_epsg()
+    return (epsg, None) if epsg is not None else (None, crs.to_wkt())
+
+
 def _point_columns(points: Any, scanner: Optional[int]) -> Dict[str, Any]:
     """x, y, z, gps_time (f64), scan_angle (degrees, f32), intensity (u16), and the CRS."""
     crs_epsg: Optional[int] = None
@@ -145,14 +164,7 @@ def _point_columns(points: Any, scanner: Optional[int]) -> Dict[str, Any]:
             channel = None
         intensity = np.asarray(points["intensity"], dtype=np.uint16)
         source_id = np.asarray(points["point_source_id"], dtype=np.uint16)
-        try:
-            crs = points.header.parse_crs()
-        except Exception:  # pyproj missing or a CRS it cannot read: the output has none
-            crs = None
-        if crs is not None:
-            crs_epsg = crs.to_epsg()
-            if crs_epsg is None:
-                crs_wkt = crs.to_wkt()
+        crs_epsg, crs_wkt = _las_crs(points.header)
     else:
         a = points
         keys = set(a.dtype.names or ()) if hasattr(a, "dtype") else set(a.keys())
