@@ -548,11 +548,12 @@ pub fn extract_columns(
                 path: PathBuf::from("(config)"),
                 what,
             })?;
-            let kernel = run::run_kernel(&cols, trajectory, &words, &cfg.replay, &|_| {})
-                .map_err(|source| ExtractError::Replay {
+            let kernel = run::run_kernel(&cols, trajectory, &words, &cfg.replay, &|_| {}).map_err(
+                |source| ExtractError::Replay {
                     path: points_name.to_path_buf(),
                     source,
-                })?;
+                },
+            )?;
             let input = BendInput {
                 x: &cols.x,
                 y: &cols.y,

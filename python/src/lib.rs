@@ -184,9 +184,8 @@ fn extract_files(
     py.allow_threads(move || {
         let progress = Progress::hidden();
         let result = match opts.method {
-            Method::Bend => {
-                stream::extract(&paths, &trajectory, &cfg, &opts, &window, &progress).map_err(err)?
-            }
+            Method::Bend => stream::extract(&paths, &trajectory, &cfg, &opts, &window, &progress)
+                .map_err(err)?,
             Method::Qiu => {
                 let [points] = paths.as_slice() else {
                     return Err(CurbtraceError::new_err(format!(
@@ -252,8 +251,9 @@ fn bend_angles<'py>(
         )));
     }
     let params: KernelParams = match params_json {
-        Some(j) => serde_json::from_str(j)
-            .map_err(|e| CurbtraceError::new_err(format!("params: {e}")))?,
+        Some(j) => {
+            serde_json::from_str(j).map_err(|e| CurbtraceError::new_err(format!("params: {e}")))?
+        }
         None => KernelParams::DEFAULT,
     };
     let mut kernel: Box<Kernel<LINE_CAPACITY>> = Box::new(Kernel::new(KernelParams::DEFAULT));

@@ -38,8 +38,3 @@ def test_dask_short_sections_many_tasks_equal_the_cli_with_the_same_sections(cam
     assert sum(len(f["geometry"]["coordinates"]) for f in got["features"]) > 0
 
 
-def test_dask_geodataframe(campaign, sim, client):
-    pytest.importorskip("geopandas")
-    gdf = curbtrace.dask.extract_campaign(campaign, sim / "trajectory.csv", client, as_geodataframe=True)
-    fc = curbtrace.extract_file(campaign, sim / "trajectory.csv")
-    assert len(gdf) == len(fc["features"])

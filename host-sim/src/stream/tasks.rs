@@ -69,7 +69,10 @@ pub fn plan(traj: &Trajectory, window: &WindowParams, tasks: usize) -> Vec<TaskS
     // The latest sample time at or before station `s`, and the earliest at or after it.
     let before = |s: f64| {
         let i = arc.partition_point(|&a| a <= s);
-        times.get(i.saturating_sub(1)).copied().unwrap_or(f64::NEG_INFINITY)
+        times
+            .get(i.saturating_sub(1))
+            .copied()
+            .unwrap_or(f64::NEG_INFINITY)
     };
     let after = |s: f64| {
         let i = arc.partition_point(|&a| a < s);
@@ -125,7 +128,8 @@ pub fn run(
     };
     let mut source = Campaign::open(&files, &read).map_err(ExtractError::Source)?;
     let mut core = CoreStage::new(traj, words, cfg.replay);
-    let mut win = SectionWindow::new(traj, *window, cfg.bend.clone()).keeping(task.sections.clone());
+    let mut win =
+        SectionWindow::new(traj, *window, cfg.bend.clone()).keeping(task.sections.clone());
     let (t0, t1) = task.times;
     let mut pending = PointBatch::with_capacity(STREAM_BATCH_POINTS);
     let mut whole = Vec::new();
@@ -140,10 +144,8 @@ pub fn run(
         // Whole batches to the core, as `extract` gives it: its line rule is chosen on
         // the first one.
         if pending.len() >= STREAM_BATCH_POINTS {
-            let full = std::mem::replace(
-                &mut pending,
-                PointBatch::with_capacity(STREAM_BATCH_POINTS),
-            );
+            let full =
+                std::mem::replace(&mut pending, PointBatch::with_capacity(STREAM_BATCH_POINTS));
             if let Some(c) = core.push(full).map_err(|e| stream_err(e.to_string()))? {
                 whole.extend(win.push(c));
             }
