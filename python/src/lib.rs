@@ -413,16 +413,24 @@ fn merge_tasks(
     })
 }
 
+// Pieces travel between processes as JSON with every f64 as its bit pattern (a u64), so
+// that the merge sees exactly the numbers the task computed.
+fn bits(v: f64) -> u64 {
+    v.to_bits()
+}
+
 fn piece_json(p: &Piece) -> Value {
     let l = p.line();
     let (open_start, open_end, cut) = p.ends();
+    let points: Vec<[u64; 3]> = l.points.iter().map(|q| q.map(bits)).collect();
+    let steps: Vec<Option<u64>> = p.steps().iter().map(|s| s.map(bits)).collect();
     json!({
-        "points": l.points,
+        "points": points,
         "side": l.side.as_str(),
         "category": l.category.map(|c| c.as_str()),
         "method": l.method,
-        "curb_height_m": l.curb_height_m,
-        "steps": p.steps(),
+        "curb_height_m": l.curb_height_m.map(bits),
+        "steps": steps,
         "open_start": open_start,
         "open_end": open_end,
         "cut": cut,
@@ -431,8 +439,8 @@ fn piece_json(p: &Piece) -> Value {
 
 fn piece_from(v: &Value) -> PyResult<Piece> {
     let bad = || CurbtraceError::new_err("task pieces: a piece is malformed");
-    let points: Vec<[f64; 3]> = serde_json::from_value(v["points"].clone()).map_err(|_| bad())?;
-    let steps: Vec<Option<f64>> = serde_json::from_value(v["steps"].clone()).map_err(|_| bad())?;
+    let points: Vec<[u64; 3]> = serde_json::from_value(v["points"].clone()).map_err(|_| bad())?;
+    let steps: Vec<Option<u64>> = serde_json::from_value(v["steps"].clone()).map_err(|_| bad())?;
     let side = match v["side"].as_str() {
         Some("left") => Side::Left,
         Some("right") => Side::Right,
@@ -443,12 +451,13 @@ fn piece_from(v: &Value) -> PyResult<Piece> {
         None => None,
     };
     let line = EdgeLine {
-        points,
+        points: points.into_iter().map(|q| q.map(f64::from_bits)).collect(),
         side,
         category,
         method: v["method"].as_str().map(str::to_string),
-        curb_height_m: v["curb_height_m"].as_f64(),
+        curb_height_m: v["curb_height_m"].as_u64().map(f64::from_bits),
     };
+    let steps = steps.into_iter().map(|s| s.map(f64::from_bits)).collect();
     let flag = |k: &str| v[k].as_bool().ok_or_else(bad);
     Ok(if flag("cut")? {
         Piece::cut(line, steps, flag("open_start")?, flag("open_end")?)
