@@ -131,7 +131,6 @@ pub fn run(
     let mut win =
         SectionWindow::new(traj, *window, cfg.bend.clone()).keeping(task.sections.clone());
     let (t0, t1) = task.times;
-    let mut pending = PointBatch::with_capacity(STREAM_BATCH_POINTS);
     let mut whole = Vec::new();
     loop {
         let b = source
@@ -140,23 +139,24 @@ pub fn run(
         let Some(b) = b else { break };
         let lo = b.t.partition_point(|&t| t < t0);
         let hi = b.t.partition_point(|&t| t < t1);
-        pending.extend_from(&b, lo..hi);
-        // Whole batches to the core, as `extract` gives it: its line rule is chosen on
-        // the first one.
-        if pending.len() >= STREAM_BATCH_POINTS {
-            let full =
-                std::mem::replace(&mut pending, PointBatch::with_capacity(STREAM_BATCH_POINTS));
-            if let Some(c) = core.push(full).map_err(|e| stream_err(e.to_string()))? {
+        // The source's batches go to the core as they are (only cut to the task's times):
+        // the core's work is cut at batch boundaries, so these are `extract`'s batches.
+        if lo == 0 && hi == b.len() {
+            if let Some(c) = core.push(b).map_err(|e| stream_err(e.to_string()))? {
+                whole.extend(win.push(c));
+            }
+            continue;
+        }
+        let mut part = PointBatch::with_capacity(hi - lo);
+        part.extend_from(&b, lo..hi);
+        let past = hi < b.len();
+        if !part.is_empty() {
+            if let Some(c) = core.push(part).map_err(|e| stream_err(e.to_string()))? {
                 whole.extend(win.push(c));
             }
         }
-        if hi < b.len() {
+        if past {
             break;
-        }
-    }
-    if !pending.is_empty() {
-        if let Some(c) = core.push(pending).map_err(|e| stream_err(e.to_string()))? {
-            whole.extend(win.push(c));
         }
     }
     if let Some(c) = core.finish().map_err(|e| stream_err(e.to_string()))? {
