@@ -86,6 +86,40 @@ for t in overflow hardfault panic; do
   fi
 done
 
+# --- the Python package (python/, docs/python.md) ----------------------------------------
+step "python: cargo fmt --check and clippy (-D warnings) on python/ (its own workspace), with the workspace's target directory"
+cargo fmt --check --manifest-path python/Cargo.toml
+CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$ROOT/target}" \
+  cargo clippy --manifest-path python/Cargo.toml --all-targets -- -D warnings
+
+step "python: the curbtrace wheel built with maturin into a fresh venv, installed with its pinned test dependencies from PyPI, pytest"
+# The machine's CPython on PATH (3.11 with pip) has venv and ensurepip; Debian's
+# /usr/bin/python3 has them only with python3-venv, so it is the fallback.
+PY=python3
+if ! "$PY" -c 'import venv, ensurepip' >/dev/null 2>&1; then
+  export DEBIAN_FRONTEND=noninteractive
+  /usr/bin/python3 -c 'import venv, ensurepip' >/dev/null 2>&1 ||
+    { apt-get update -qq && apt-get install -y -qq python3-venv >/dev/null; }
+  PY=/usr/bin/python3
+fi
+PY_WORK=$(mktemp -d)
+"$PY" -m venv "$PY_WORK/venv"
+"$PY_WORK/venv/bin/pip" install -q --disable-pip-version-check -r python/requirements-test.txt
+# The release build of the workspace is reused: only pyo3 and the module itself compile.
+CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$ROOT/target}" \
+  "$PY_WORK/venv/bin/maturin" build --release --quiet -m python/Cargo.toml \
+  -i "$PY_WORK/venv/bin/python" -o "$PY_WORK/dist"
+"$PY_WORK/venv/bin/pip" install -q --disable-pip-version-check "$PY_WORK"/dist/curbtrace-*.whl
+(cd "$PY_WORK" && "$PY_WORK/venv/bin/python" -c 'import curbtrace, curbtrace.dask; print("import curbtrace", curbtrace.__version__)')
+rc=0
+CURBTRACE_BIN="${CARGO_TARGET_DIR:-$ROOT/target}/release/curbtrace" \
+  "$PY_WORK/venv/bin/python" -m pytest -q -p no:cacheprovider python/tests || rc=$?
+rm -rf "$PY_WORK"
+# pytest: 0 all passed; 5 no test collected, which here means the suite is missing.
+if [ "$rc" -ne 0 ]; then
+  echo "python tests: pytest exit status $rc"; exit 1
+fi
+
 # --- fuzzing (fuzz/, docs/robustness.md) ------------------------------------------------
 ./scripts/fuzz-smoke.sh
 

@@ -272,12 +272,18 @@ pub fn read_geojson(path: &std::path::Path) -> Result<(Vec<EdgeLine>, Option<Crs
         path: p.clone(),
         source,
     })?;
+    parse_geojson(&p, &text)
+}
+
+/// [`read_geojson`] on GeoJSON text held in memory; `name` stands for the file in messages.
+pub fn parse_geojson(name: &str, text: &str) -> Result<(Vec<EdgeLine>, Option<Crs>), GeoJsonError> {
+    let p = name.to_string();
     let fmt = |what: String| GeoJsonError::Format {
         path: p.clone(),
         what,
     };
     let v: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| fmt(format!("not JSON: {e}")))?;
+        serde_json::from_str(text).map_err(|e| fmt(format!("not JSON: {e}")))?;
     if v.get("type").and_then(|t| t.as_str()) != Some("FeatureCollection") {
         return Err(fmt("not a GeoJSON FeatureCollection".into()));
     }

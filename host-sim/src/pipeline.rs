@@ -527,3 +527,67 @@ fn extract_qiu(
         summary,
     })
 }
+
+/// The job of [`extract_file_with`] on points a library caller holds in memory (one
+/// scanner, sorted by time): the points outside the trajectory are dropped and counted,
+/// then the method runs as on a file. `points_name` and `traj_name` stand for the files in
+/// messages. Returns the edges and the points dropped before / after the trajectory.
+pub fn extract_columns(
+    mut cols: PointColumns,
+    points_name: &Path,
+    trajectory: &Trajectory,
+    traj_name: &Path,
+    cfg: &Config,
+    method: Method,
+) -> Result<(Vec<EdgeLine>, (u64, u64)), ExtractError> {
+    if !cols.is_time_ordered() {
+        return Err(ExtractError::Stream {
+            path: points_name.to_path_buf(),
+            what: "points are not in time order".into(),
+        });
+    }
+    let cov = trajectory.coverage(&cols.t, traj_name, points_name)?;
+    if cov.dropped() > 0 {
+        cols.keep_range(cov.start..cov.end);
+    }
+    let mut edges = match method {
+        Method::Qiu => {
+            let input = crate::qiu::QiuInput {
+                x: &cols.x,
+                y: &cols.y,
+                z: &cols.z,
+                t: &cols.t,
+                trajectory,
+            };
+            crate::qiu::extract_edges(&input, &cfg.qiu)
+        }
+        Method::Bend => {
+            let words = cfg.kernel_words().map_err(|what| ConfigError::Kernel {
+                path: PathBuf::from("(config)"),
+                what,
+            })?;
+            let kernel = run::run_kernel(&cols, trajectory, &words, &cfg.replay, &|_| {}).map_err(
+                |source| ExtractError::Replay {
+                    path: points_name.to_path_buf(),
+                    source,
+                },
+            )?;
+            let input = BendInput {
+                x: &cols.x,
+                y: &cols.y,
+                z: &cols.z,
+                t: &cols.t,
+                rho_deg: &kernel.rho_deg,
+                status: &kernel.status,
+                scanline: &kernel.scanline,
+                candidates: &kernel.candidates,
+                trajectory,
+            };
+            bend::extract_edges(&input, &cfg.bend)
+        }
+    };
+    for e in &mut edges {
+        e.method.get_or_insert_with(|| method.as_str().to_string());
+    }
+    Ok((edges, (cov.before as u64, cov.after as u64)))
+}

@@ -44,6 +44,22 @@ impl Piece {
             cut: true,
         }
     }
+
+    /// The piece's line.
+    pub fn line(&self) -> &EdgeLine {
+        &self.line
+    }
+
+    /// The height step at each vertex, where measured.
+    pub fn steps(&self) -> &[Option<f64>] {
+        &self.steps
+    }
+
+    /// Whether the piece is cut at its start, at its end, and at all ([`Piece::cut`]) —
+    /// with the line and steps, what rebuilds it elsewhere.
+    pub fn ends(&self) -> (bool, bool, bool) {
+        (self.open_start, self.open_end, self.cut)
+    }
 }
 
 /// Pieces waiting for the next section.

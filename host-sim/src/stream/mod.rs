@@ -15,9 +15,11 @@
 //! - [`core_stage`] — the core stage (batches cut at line starts).
 //! - [`window`] — sections along the route, the bend method per window.
 //! - [`merge`] — joining pieces at section boundaries.
+//! - [`tasks`] — the campaign cut into independent tasks of whole sections, merged after.
 
 pub mod core_stage;
 pub mod merge;
+pub mod tasks;
 pub mod window;
 
 use crate::config::{Config, ConfigError};

@@ -138,6 +138,10 @@ pub struct SectionWindow<'a> {
     /// Station where the next section starts.
     start: f64,
     merge: Merge,
+    /// Sections whose pieces are kept for a merge elsewhere instead of merged here.
+    keep: Option<std::ops::Range<i64>>,
+    /// The kept sections' pieces, in section order.
+    kept: Vec<(i64, Vec<Piece>)>,
     /// Most points the window held at once.
     pub peak_points: usize,
     /// Points dropped by the time cap (`max_s`).
@@ -151,20 +155,45 @@ const CAP_MIN_SECTION_M: f64 = 1.0;
 impl<'a> SectionWindow<'a> {
     /// A window over `traj`'s route.
     pub fn new(traj: &'a Trajectory, params: WindowParams, bend: BendParams) -> Self {
-        // Two pieces of one curb meet within a few search steps of each other.
-        let stitch = (3.0 * bend.search_distance_m).max(bend.join_distance_m);
-        let min_len = bend.min_edge_length_m;
         Self {
             traj,
             route: Route::new(traj),
+            merge: Self::merge_for(&bend),
             bend,
             params,
             cols: Columns::default(),
             start: 0.0,
             merge: Merge::new(stitch, min_len),
+            keep: None,
+            kept: Vec::new(),
             peak_points: 0,
             capped_points: 0,
         }
+    }
+
+    /// The merge a window with `bend`'s parameters joins its pieces with.
+    pub fn merge_for(bend: &BendParams) -> Merge {
+        // Two pieces of one curb meet within a few search steps of each other.
+        let stitch = (3.0 * bend.search_distance_m).max(bend.join_distance_m);
+        Merge::new(stitch, bend.min_edge_length_m)
+    }
+
+    /// A window that merges nothing: the pieces of the sections in `sections` are kept
+    /// (see [`take_pieces`](Self::take_pieces)), those of other sections dropped. One task of
+    /// a campaign cut into independent runs (`stream::tasks`).
+    pub fn keeping(mut self, sections: std::ops::Range<i64>) -> Self {
+        self.keep = Some(sections);
+        self
+    }
+
+    /// The kept sections' pieces, in section order (a section without pieces is listed).
+    pub fn take_pieces(&mut self) -> Vec<(i64, Vec<Piece>)> {
+        std::mem::take(&mut self.kept)
+    }
+
+    /// True when the whole route is one section (the window is the whole input).
+    pub fn is_single(&self) -> bool {
+        self.single()
     }
 
     fn section_m(&self) -> f64 {
@@ -240,7 +269,9 @@ impl<'a> SectionWindow<'a> {
         while self.start <= end && !self.cols.t.is_empty() {
             out.extend(self.run_section(self.start + l));
         }
-        out.extend(self.merge.close_all());
+        if self.keep.is_none() {
+            out.extend(self.merge.close_all());
+        }
         out
     }
 
@@ -260,7 +291,18 @@ impl<'a> SectionWindow<'a> {
         for (e, steps) in edges {
             pieces.extend(cut_to_section(&self.route, e, steps, s0, s1));
         }
-        let closed = self.merge.push(pieces, s0, s1);
+        let closed = match &self.keep {
+            None => self.merge.push(pieces, s0, s1),
+            Some(keep) => {
+                // A section closed early by the time cap keeps the index of the
+                // section it starts in.
+                let k = ((s0 + 1e-9) / self.section_m()).floor() as i64;
+                if keep.contains(&k) {
+                    self.kept.push((k, pieces));
+                }
+                Vec::new()
+            }
+        };
         self.start = s1;
         let keep_from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
         self.cols.evict(keep_from);

@@ -1,0 +1,235 @@
+//! A campaign cut into independent tasks of whole sections, for runs spread over several
+//! processes or machines (the Python package's Dask driver).
+//!
+//! The route's sections (see [`window`](super::window)) are split into runs of consecutive
+//! sections, one per task. A task reads only the points measured while the vehicle was
+//! within its sections' windows plus [`PAD_M`] of road on either side (a scanline cut at
+//! the task's first or last point lies in that pad, outside every window the task keeps),
+//! runs the core and the section window exactly as `extract` does, and keeps the pieces of
+//! its own sections unmerged. [`merge`] feeds every section's pieces, in section order,
+//! through the [`Merge`] that `extract` uses, so the edges are those of one `extract` run.
+
+use super::core_stage::CoreStage;
+use super::merge::{Merge, Piece};
+use super::window::{SectionWindow, WindowParams};
+use super::STREAM_BATCH_POINTS;
+use crate::bend::route::Route;
+use crate::bend::BendParams;
+use crate::config::{Config, ConfigError};
+use crate::io::las_in::ReadOptions;
+use crate::io::trajectory::Trajectory;
+use crate::model::EdgeLine;
+use crate::pipeline::{ExtractError, ExtractOptions, Method};
+use crate::source::campaign::Campaign;
+use crate::source::las_batches::LasBatches;
+use crate::source::PointBatch;
+use std::ops::Range;
+use std::path::PathBuf;
+
+/// Road read before and after a task's windows, metres: more than the vehicle covers in
+/// one scanline.
+pub const PAD_M: f64 = 5.0;
+
+/// One task: the sections whose pieces it keeps and the GPS times of the points it reads.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TaskSpec {
+    /// Section indices, `[k0, k1)`.
+    pub sections: Range<i64>,
+    /// Points with `times.0 <= t < times.1` are read.
+    pub times: (f64, f64),
+}
+
+/// What one task produced.
+pub struct TaskOutput {
+    /// Each kept section's pieces, in section order.
+    pub pieces: Vec<(i64, Vec<Piece>)>,
+    /// Points that went through the core.
+    pub points: u64,
+}
+
+/// Cuts the route of `traj` into at most `tasks` tasks of consecutive sections. A route
+/// shorter than one section is one task (the window is then the whole input).
+pub fn plan(traj: &Trajectory, window: &WindowParams, tasks: usize) -> Vec<TaskSpec> {
+    let route = Route::new(traj);
+    let l = window.section_m.max(1.0);
+    let m = window.margin_m.max(0.0);
+    let length = route.length_m();
+    // `SectionWindow` runs sections 0, 1, … while k·l ≤ the route's length.
+    let sections = if l > length {
+        1
+    } else {
+        (length / l).floor() as i64 + 1
+    };
+    let n = (tasks.max(1) as i64).min(sections);
+    let times: Vec<f64> = traj.samples.iter().map(|p| p.t).collect();
+    let arc: Vec<f64> = times
+        .iter()
+        .map(|&t| route.arc_at(t).unwrap_or(0.0))
+        .collect();
+    // The latest sample time at or before station `s`, and the earliest at or after it.
+    let before = |s: f64| {
+        let i = arc.partition_point(|&a| a <= s);
+        times
+            .get(i.saturating_sub(1))
+            .copied()
+            .unwrap_or(f64::NEG_INFINITY)
+    };
+    let after = |s: f64| {
+        let i = arc.partition_point(|&a| a < s);
+        times.get(i).copied().unwrap_or(f64::INFINITY)
+    };
+    (0..n)
+        .map(|i| {
+            let k0 = sections * i / n;
+            let k1 = sections * (i + 1) / n;
+            let t0 = if i == 0 {
+                f64::NEG_INFINITY
+            } else {
+                before(k0 as f64 * l - m - PAD_M)
+            };
+            let t1 = if i == n - 1 {
+                f64::INFINITY
+            } else {
+                after(k1 as f64 * l + m + PAD_M)
+            };
+            TaskSpec {
+                sections: k0..k1,
+                times: (t0, t1),
+            }
+        })
+        .collect()
+}
+
+/// Runs one task: the points of `task.times` from the campaign `inputs` through the core
+/// and the section window, keeping the pieces of `task.sections`.
+pub fn run(
+    inputs: &[PathBuf],
+    traj: &Trajectory,
+    cfg: &Config,
+    opts: &ExtractOptions,
+    window: &WindowParams,
+    task: &TaskSpec,
+) -> Result<TaskOutput, ExtractError> {
+    if opts.method != Method::Bend {
+        return Err(ExtractError::Method(opts.method.as_str().into()));
+    }
+    let words = cfg.kernel_words().map_err(|what| ConfigError::Kernel {
+        path: PathBuf::from("(config)"),
+        what,
+    })?;
+    let read = ReadOptions {
+        scanner: opts.scanner,
+    };
+    let files = files_in(inputs, &read, task.times)?;
+    let first = files.first().cloned().unwrap_or_default();
+    let stream_err = |what: String| ExtractError::Stream {
+        path: first.clone(),
+        what,
+    };
+    let mut source = Campaign::open(&files, &read).map_err(ExtractError::Source)?;
+    let mut core = CoreStage::new(traj, words, cfg.replay);
+    let mut win =
+        SectionWindow::new(traj, *window, cfg.bend.clone()).keeping(task.sections.clone());
+    let (t0, t1) = task.times;
+    let mut whole = Vec::new();
+    loop {
+        let b = source
+            .next_batch(STREAM_BATCH_POINTS)
+            .map_err(ExtractError::Source)?;
+        let Some(b) = b else { break };
+        let lo = b.t.partition_point(|&t| t < t0);
+        let hi = b.t.partition_point(|&t| t < t1);
+        // The source's batches go to the core as they are (only cut to the task's times):
+        // the core's work is cut at batch boundaries, so these are `extract`'s batches.
+        if lo == 0 && hi == b.len() {
+            if let Some(c) = core.push(b).map_err(|e| stream_err(e.to_string()))? {
+                whole.extend(win.push(c));
+            }
+            continue;
+        }
+        let mut part = PointBatch::with_capacity(hi - lo);
+        part.extend_from(&b, lo..hi);
+        let past = hi < b.len();
+        if !part.is_empty() {
+            if let Some(c) = core.push(part).map_err(|e| stream_err(e.to_string()))? {
+                whole.extend(win.push(c));
+            }
+        }
+        if past {
+            break;
+        }
+    }
+    if let Some(c) = core.finish().map_err(|e| stream_err(e.to_string()))? {
+        whole.extend(win.push(c));
+    }
+    whole.extend(win.finish());
+    let mut pieces = win.take_pieces();
+    if win.is_single() {
+        // One section holds the whole route: its edges are whole pieces.
+        pieces = vec![(
+            0,
+            whole
+                .into_iter()
+                .map(|e| {
+                    let n = e.points.len();
+                    Piece::whole(e, vec![None; n])
+                })
+                .collect(),
+        )];
+    }
+    Ok(TaskOutput {
+        pieces,
+        points: core.points,
+    })
+}
+
+/// The campaign's files (in time order) that can hold points of `times`: a file spans from
+/// its first point to the next file's first point.
+fn files_in(
+    inputs: &[PathBuf],
+    read: &ReadOptions,
+    times: (f64, f64),
+) -> Result<Vec<PathBuf>, ExtractError> {
+    let campaign = Campaign::open(inputs, read).map_err(ExtractError::Source)?;
+    let files = campaign.info().files.clone();
+    let mut first = Vec::with_capacity(files.len());
+    for f in &files {
+        let t = LasBatches::first_time(f)
+            .map_err(|e| ExtractError::Source(e.into()))?
+            .unwrap_or(f64::INFINITY);
+        first.push(t);
+    }
+    let kept: Vec<PathBuf> = files
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| {
+            let next = first.get(i + 1).copied().unwrap_or(f64::INFINITY);
+            first[i] < times.1 && next >= times.0
+        })
+        .map(|(_, f)| f.clone())
+        .collect();
+    Ok(if kept.is_empty() { files } else { kept })
+}
+
+/// The edges of the tasks' pieces: every section from the first to the last, in order,
+/// through the merge `extract` uses (a section no task lists has no pieces).
+pub fn merge(mut sections: Vec<(i64, Vec<Piece>)>, bend: &BendParams) -> Vec<EdgeLine> {
+    sections.sort_by_key(|s| s.0);
+    let mut m: Merge = SectionWindow::merge_for(bend);
+    let mut edges = Vec::new();
+    let mut next = sections.first().map_or(0, |s| s.0);
+    for (k, pieces) in sections {
+        while next < k {
+            edges.extend(m.push(Vec::new(), 0.0, 0.0));
+            next += 1;
+        }
+        edges.extend(m.push(pieces, 0.0, 0.0));
+        next = k + 1;
+    }
+    edges.extend(m.close_all());
+    for e in &mut edges {
+        e.method
+            .get_or_insert_with(|| Method::Bend.as_str().to_string());
+    }
+    edges
+}
