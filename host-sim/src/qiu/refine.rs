@@ -81,9 +81,23 @@ pub fn refine_by_width(pts: &[EdgePoint], params: &QiuParams) -> WidthRefinement
     let mut right: Vec<usize> = (0..pts.len()).filter(|&i| pts[i].d < 0.0).collect();
     right.sort_by(|&a, &b| pts[a].s.total_cmp(&pts[b].s).then(a.cmp(&b)));
     let right_s: Vec<f64> = right.iter().map(|&i| pts[i].s).collect();
+    // Only left points near the innermost left candidate of their station bin start a
+    // pair, as R_i is the right candidate nearest P_i: the width is measured between the
+    // innermost edges, so a wall or fence behind a curb (as many candidates per metre as
+    // the curb) cannot outvote it.
+    let bin = |s: f64| (s / params.bin_m).floor() as i64;
+    let mut innermost: HashMap<i64, f64> = HashMap::new();
+    for p in pts.iter().filter(|p| p.d > 0.0) {
+        let e = innermost.entry(bin(p.s)).or_insert(f64::INFINITY);
+        *e = e.min(p.d);
+    }
     // (station, width, left index, right index)
     let mut pairs: Vec<(f64, f64, usize, usize)> = Vec::new();
-    for (li, l) in pts.iter().enumerate().filter(|(_, p)| p.d > 0.0) {
+    for (li, l) in pts
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.d > 0.0 && p.d <= innermost[&bin(p.s)] + params.width_tolerance_m)
+    {
         let dir = [l.foot[0] - l.p[0], l.foot[1] - l.p[1]];
         let len = dir[0].hypot(dir[1]);
         if len < 1e-9 {
