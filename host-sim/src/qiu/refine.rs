@@ -153,10 +153,11 @@ pub fn refine_by_width(pts: &[EdgePoint], params: &QiuParams) -> WidthRefinement
             Some((a, b, m)) if (a, b) == (lo, hi) => m,
             _ => {
                 // Ties go to the smaller width, as in `mode`.
-                let (best, _) = hist
-                    .iter()
-                    .enumerate()
-                    .fold((0, 0), |(bi, bc), (i, &c)| if c > bc { (i, c) } else { (bi, bc) });
+                let (best, _) =
+                    hist.iter().enumerate().fold(
+                        (0, 0),
+                        |(bi, bc), (i, &c)| if c > bc { (i, c) } else { (bi, bc) },
+                    );
                 let m = ((best as i64 + kmin) as f64 + 0.5) * params.width_bin_m;
                 window_mode = Some((lo, hi, m));
                 m
