@@ -260,6 +260,7 @@ fn process_section(
         params.min_candidates,
         params.energy_tolerance,
         params.energy_slack_m,
+        params.noise_count_ratio,
         params.seed ^ (sec.index as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15),
         &|i| locate(i).map(|p| (p.s, p.d)),
     );

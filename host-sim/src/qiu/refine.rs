@@ -81,9 +81,23 @@ pub fn refine_by_width(pts: &[EdgePoint], params: &QiuParams) -> WidthRefinement
     let mut right: Vec<usize> = (0..pts.len()).filter(|&i| pts[i].d < 0.0).collect();
     right.sort_by(|&a, &b| pts[a].s.total_cmp(&pts[b].s).then(a.cmp(&b)));
     let right_s: Vec<f64> = right.iter().map(|&i| pts[i].s).collect();
+    // Only left points near the innermost left candidate of their station bin start a
+    // pair, as R_i is the right candidate nearest P_i: the width is measured between the
+    // innermost edges, so a wall or fence behind a curb (as many candidates per metre as
+    // the curb) cannot outvote it.
+    let bin = |s: f64| (s / params.bin_m).floor() as i64;
+    let mut innermost: HashMap<i64, f64> = HashMap::new();
+    for p in pts.iter().filter(|p| p.d > 0.0) {
+        let e = innermost.entry(bin(p.s)).or_insert(f64::INFINITY);
+        *e = e.min(p.d);
+    }
     // (station, width, left index, right index)
     let mut pairs: Vec<(f64, f64, usize, usize)> = Vec::new();
-    for (li, l) in pts.iter().enumerate().filter(|(_, p)| p.d > 0.0) {
+    for (li, l) in pts
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.d > 0.0 && p.d <= innermost[&bin(p.s)] + params.width_tolerance_m)
+    {
         let dir = [l.foot[0] - l.p[0], l.foot[1] - l.p[1]];
         let len = dir[0].hypot(dir[1]);
         if len < 1e-9 {
@@ -115,11 +129,39 @@ pub fn refine_by_width(pts: &[EdgePoint], params: &QiuParams) -> WidthRefinement
     let mut matched: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
     let half = 0.5 * params.width_window_m;
     let mut is_matched = vec![false; pts.len()];
+    // The most frequent width of every pair's window: the window slides along the sorted
+    // stations, so one histogram is updated as pairs enter and leave it.
+    let bins: Vec<i64> = pairs
+        .iter()
+        .map(|p| (p.1 / params.width_bin_m).floor() as i64)
+        .collect();
+    let kmin = bins.iter().copied().min().unwrap_or(0);
+    let kmax = bins.iter().copied().max().unwrap_or(0);
+    let mut hist = vec![0usize; (kmax - kmin + 1) as usize];
+    let (mut lo, mut hi) = (0, 0);
+    let mut window_mode: Option<(usize, usize, f64)> = None;
     for (k, &(s, w, li, ri)) in pairs.iter().enumerate() {
-        let lo = pairs[..k].partition_point(|p| p.0 < s - half);
-        let hi = k + pairs[k..].partition_point(|p| p.0 <= s + half);
-        let Some(wm) = mode(pairs[lo..hi].iter().map(|p| p.1), params.width_bin_m) else {
-            continue;
+        while hi < pairs.len() && pairs[hi].0 <= s + half {
+            hist[(bins[hi] - kmin) as usize] += 1;
+            hi += 1;
+        }
+        while lo < k && pairs[lo].0 < s - half {
+            hist[(bins[lo] - kmin) as usize] -= 1;
+            lo += 1;
+        }
+        let wm = match window_mode {
+            Some((a, b, m)) if (a, b) == (lo, hi) => m,
+            _ => {
+                // Ties go to the smaller width, as in `mode`.
+                let (best, _) =
+                    hist.iter().enumerate().fold(
+                        (0, 0),
+                        |(bi, bc), (i, &c)| if c > bc { (i, c) } else { (bi, bc) },
+                    );
+                let m = ((best as i64 + kmin) as f64 + 0.5) * params.width_bin_m;
+                window_mode = Some((lo, hi, m));
+                m
+            }
         };
         if (w - wm).abs() <= params.width_tolerance_m {
             is_matched[li] = true;
@@ -133,17 +175,23 @@ pub fn refine_by_width(pts: &[EdgePoint], params: &QiuParams) -> WidthRefinement
         m.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     }
     let ohalf = 0.5 * params.offset_window_m;
+    // Points with the same window share its median.
+    let mut window_median: [HashMap<(usize, usize), Option<f64>>; 2] = Default::default();
     let mut kept = Vec::new();
     for (i, p) in pts.iter().enumerate() {
         if is_matched[i] {
             kept.push(i);
             continue;
         }
-        let m = &matched[usize::from(p.d < 0.0)];
+        let side = usize::from(p.d < 0.0);
+        let m = &matched[side];
         let lo = m.partition_point(|q| q.0 < p.s - ohalf);
         let hi = m.partition_point(|q| q.0 <= p.s + ohalf);
-        let mut offs: Vec<f64> = m[lo..hi].iter().map(|q| q.1).collect();
-        match median(&mut offs) {
+        let e = *window_median[side].entry((lo, hi)).or_insert_with(|| {
+            let mut offs: Vec<f64> = m[lo..hi].iter().map(|q| q.1).collect();
+            median(&mut offs)
+        });
+        match e {
             None => kept.push(i),
             Some(e) if (p.d.abs() - e).abs() <= params.width_tolerance_m => kept.push(i),
             Some(_) => {}

@@ -273,6 +273,7 @@ pub fn rough_segmentation(
     min_candidates: usize,
     energy_tolerance: f64,
     energy_slack_m: f64,
+    noise_count_ratio: f64,
     seed: u64,
     position_of: &dyn Fn(usize) -> Option<(f64, f64)>,
 ) -> Segmentation {
@@ -319,7 +320,16 @@ pub fn rough_segmentation(
             }
         }
     }
-    for (side, sets) in sets.into_iter().enumerate() {
+    for (side, mut sets) in sets.into_iter().enumerate() {
+        // The smallest βs lie within the noise while their candidate count is more than
+        // `noise_count_ratio` times the next larger β's: noise outliers fill the road, an
+        // edge's candidates thin out slowly with β.
+        sets.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let noisy = sets
+            .windows(2)
+            .take_while(|w| w[0].2.len() as f64 > noise_count_ratio * w[1].2.len() as f64)
+            .count();
+        sets.drain(..noisy);
         let Some(e_min) = sets.iter().map(|s| s.0).min_by(f64::total_cmp) else {
             continue;
         };
