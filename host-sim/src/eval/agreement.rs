@@ -88,6 +88,7 @@ mod tests {
             category: None,
             method: None,
             curb_height_m: None,
+            detail: None,
         }
     }
 

@@ -163,7 +163,6 @@ impl<'a> SectionWindow<'a> {
             params,
             cols: Columns::default(),
             start: 0.0,
-            merge: Merge::new(stitch, min_len),
             keep: None,
             kept: Vec::new(),
             peak_points: 0,
