@@ -15,9 +15,16 @@ fn check_edges(geojson: &std::path::Path, road: &Road) {
     let feats = v["features"].as_array().unwrap();
     let (left_x, right_x) = road.toe_x();
     let mut sides = Vec::new();
+    let mut tops = Vec::new();
     for f in feats {
         let p = &f["properties"];
         assert_eq!(p["method"], "bend");
+        // Schema 2: every stretch is a toe feature and a top-of-curb feature.
+        if p["line"] == "top" {
+            tops.push(p["side"].as_str().unwrap().to_string());
+            continue;
+        }
+        assert_eq!(p["line"], "toe", "a feature is a toe or a top");
         let side = p["side"].as_str().unwrap().to_string();
         let toe = if side == "left" { left_x } else { right_x };
         let coords = f["geometry"]["coordinates"].as_array().unwrap();
@@ -50,6 +57,8 @@ fn check_edges(geojson: &std::path::Path, road: &Road) {
     }
     sides.sort();
     assert_eq!(sides, vec!["left", "right"], "both toes and nothing else");
+    tops.sort();
+    assert_eq!(tops, sides, "a top of curb beside each toe");
 }
 
 #[test]
