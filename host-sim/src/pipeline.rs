@@ -583,7 +583,13 @@ pub fn extract_columns(
                 candidates: &kernel.candidates,
                 trajectory,
             };
-            bend::extract_edges(&input, &cfg.bend)
+            let mut edges = bend::extract_edges(&input, &cfg.bend);
+            crate::curb::annotate(
+                &input,
+                &bend::route::Route::new(trajectory),
+                edges.iter_mut(),
+            );
+            crate::curb::finish(edges)
         }
     };
     for e in &mut edges {

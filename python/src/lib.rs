@@ -10,7 +10,7 @@ use curbtrace_host_sim::config::Config;
 use curbtrace_host_sim::eval::{self, EvalParams};
 use curbtrace_host_sim::io::las_in::PointColumns;
 use curbtrace_host_sim::io::trajectory::Trajectory;
-use curbtrace_host_sim::model::{self, Category, Crs, EdgeLine, Side};
+use curbtrace_host_sim::model::{self, Category, Crs, CurbDetail, EdgeLine, Side};
 use curbtrace_host_sim::output::format::resolve;
 use curbtrace_host_sim::output::geojson::lines_to_geojson;
 use curbtrace_host_sim::output::write_edges_as;
@@ -430,10 +430,44 @@ fn piece_json(p: &Piece) -> Value {
         "category": l.category.map(|c| c.as_str()),
         "method": l.method,
         "curb_height_m": l.curb_height_m.map(bits),
+        "detail": l.detail.as_ref().map(detail_json),
         "steps": steps,
         "open_start": open_start,
         "open_end": open_end,
         "cut": cut,
+    })
+}
+
+fn detail_json(d: &CurbDetail) -> Value {
+    let top: Vec<[u64; 3]> = d.top.iter().map(|q| q.map(bits)).collect();
+    let height: Vec<u64> = d.height_m.iter().map(|&h| bits(h)).collect();
+    let class: Vec<&str> = d.class.iter().map(|c| c.as_str()).collect();
+    json!({
+        "top": top,
+        "height_m": height,
+        "measured": d.measured,
+        "top_measured": d.top_measured,
+        "class": class,
+        "bridged": d.bridged,
+        "support_per_m": bits(d.support_per_m),
+    })
+}
+
+fn detail_from(v: &Value) -> Option<CurbDetail> {
+    let top: Vec<[u64; 3]> = serde_json::from_value(v["top"].clone()).ok()?;
+    let height: Vec<u64> = serde_json::from_value(v["height_m"].clone()).ok()?;
+    let class: Vec<String> = serde_json::from_value(v["class"].clone()).ok()?;
+    Some(CurbDetail {
+        top: top.into_iter().map(|q| q.map(f64::from_bits)).collect(),
+        height_m: height.into_iter().map(f64::from_bits).collect(),
+        measured: serde_json::from_value(v["measured"].clone()).ok()?,
+        top_measured: serde_json::from_value(v["top_measured"].clone()).ok()?,
+        class: class
+            .iter()
+            .map(|c| Category::parse(c))
+            .collect::<Option<Vec<_>>>()?,
+        bridged: v["bridged"].as_bool()?,
+        support_per_m: f64::from_bits(v["support_per_m"].as_u64()?),
     })
 }
 
@@ -456,6 +490,10 @@ fn piece_from(v: &Value) -> PyResult<Piece> {
         category,
         method: v["method"].as_str().map(str::to_string),
         curb_height_m: v["curb_height_m"].as_u64().map(f64::from_bits),
+        detail: match &v["detail"] {
+            Value::Null => None,
+            d => Some(detail_from(d).ok_or_else(bad)?),
+        },
     };
     let steps = steps.into_iter().map(|s| s.map(f64::from_bits)).collect();
     let flag = |k: &str| v[k].as_bool().ok_or_else(bad);

@@ -896,3 +896,80 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod link_checked_tests {
+    extern crate std;
+    use super::{Ingest, IngestEvent};
+
+    /// Link-checked packets (version 2, flag 1, CRC field zero) of every kind are read without
+    /// a CRC, by `Packet::check`, the scanner and ingest; a non-zero CRC field, a version-1
+    /// label or another flag bit is refused.
+    #[test]
+    fn link_checked_packets_are_read_without_a_crc() {
+        use crate::wire::{
+            mark_link_checked, scan, ConfigRepr, Packet, PointRecord, PointsRepr, Scan,
+            StreamEncoder, FLAG_LINK_CHECKED, MAX_PACKET_LEN,
+        };
+        use std::vec::Vec;
+        let mut enc = StreamEncoder::new().link_checked(true);
+        let mut buf = [0u8; MAX_PACKET_LEN];
+        let mut stream = Vec::new();
+        let n = enc.encode_config(&[0; 16], &mut buf).unwrap();
+        assert_eq!(
+            ConfigRepr::parse(&Packet::new_checked(&buf[..n]).unwrap())
+                .unwrap()
+                .words,
+            [0; 16]
+        );
+        let pts: Vec<PointRecord> = (0..40)
+            .map(|i| PointRecord {
+                dt_ns: 1000 * i,
+                x_m: -0.2 + 0.01 * i as f32,
+                z_m: -2.0,
+                intensity: 0,
+                line_start: i == 0,
+                tag: i,
+            })
+            .collect();
+        let n = enc.encode_points(5, &pts, &mut buf).unwrap();
+        let pk = Packet::new_checked(&buf[..n]).unwrap();
+        assert_eq!(
+            (pk.version(), pk.flags(), pk.crc()),
+            (2, FLAG_LINK_CHECKED, 0)
+        );
+        assert!(pk.link_checked());
+        assert_eq!(PointsRepr::parse(&pk).unwrap().points.len(), 40);
+        assert_eq!(scan(&buf[..n], true), Scan::Packet { len: n });
+        stream.extend_from_slice(&buf[..n]);
+        // The same packet with a CRC in its field, or labelled version 1, is refused.
+        let mut bad = buf[..n].to_vec();
+        bad[n - 1] = 1;
+        assert!(PointsRepr::parse(&Packet::new_checked(&bad[..]).unwrap()).is_err());
+        assert!(matches!(scan(&bad, true), Scan::Garbage { .. }));
+        let mut v1 = buf[..n].to_vec();
+        v1[2] = 1;
+        assert!(PointsRepr::parse(&Packet::new_checked(&v1[..]).unwrap()).is_err());
+        // Marking a packet written with a CRC gives the encoder's bytes.
+        let mut plain = [0u8; MAX_PACKET_LEN];
+        let m = StreamEncoder::with_seq(1)
+            .encode_points(5, &pts, &mut plain)
+            .unwrap();
+        mark_link_checked(&mut plain[..m]);
+        assert_eq!(plain[..m], buf[..n]);
+        let mut ing = Ingest::<4096, 64>::new();
+        assert_eq!(ing.write(&stream), stream.len());
+        ing.finish();
+        let mut points = 0;
+        while let Some(ev) = ing.poll() {
+            if let IngestEvent::Line(l) = ev {
+                points += l.len();
+            }
+        }
+        let c = ing.counters();
+        assert_eq!(
+            (points, c.crc_errors, c.bad_version, c.reserved_flags),
+            (40, 0, 0, 0)
+        );
+    }
+}

@@ -227,6 +227,8 @@ pub fn merge(mut sections: Vec<(i64, Vec<Piece>)>, bend: &BendParams) -> Vec<Edg
         next = k + 1;
     }
     edges.extend(m.close_all());
+    // As `extract` does after its merge: stretches of one class and one kind of support.
+    let mut edges = crate::curb::finish(edges);
     for e in &mut edges {
         e.method
             .get_or_insert_with(|| Method::Bend.as_str().to_string());
