@@ -70,7 +70,7 @@ fn crs(epsg: Option<u32>, wkt: Option<String>) -> Option<Crs> {
 
 /// Native-endian numbers from the bytes of a contiguous numpy array.
 fn column<T, const W: usize>(name: &str, b: &[u8], from: fn([u8; W]) -> T) -> PyResult<Vec<T>> {
-    if b.len() % W != 0 {
+    if !b.len().is_multiple_of(W) {
         return Err(CurbtraceError::new_err(format!(
             "column {name}: {} bytes is not a whole number of {W}-byte values",
             b.len()
@@ -212,6 +212,7 @@ fn window(section_m: Option<f64>, margin_m: Option<f64>) -> WindowParams {
     WindowParams {
         section_m: section_m.unwrap_or(d.section_m),
         margin_m: margin_m.unwrap_or(d.margin_m),
+        ..d
     }
 }
 
@@ -430,7 +431,7 @@ fn piece_json(p: &Piece) -> Value {
         "category": l.category.map(|c| c.as_str()),
         "method": l.method,
         "curb_height_m": l.curb_height_m.map(bits),
-        "detail": l.detail.as_ref().map(detail_json),
+        "detail": l.detail.as_deref().map(detail_json),
         "steps": steps,
         "open_start": open_start,
         "open_end": open_end,
@@ -492,7 +493,7 @@ fn piece_from(v: &Value) -> PyResult<Piece> {
         curb_height_m: v["curb_height_m"].as_u64().map(f64::from_bits),
         detail: match &v["detail"] {
             Value::Null => None,
-            d => Some(detail_from(d).ok_or_else(bad)?),
+            d => Some(Box::new(detail_from(d).ok_or_else(bad)?)),
         },
     };
     let steps = steps.into_iter().map(|s| s.map(f64::from_bits)).collect();
