@@ -315,7 +315,15 @@ fn evaluate(
                 "evaluating {extracted_name} against {reference_name}: {e}"
             ))
         })?;
-        Ok(report.to_json())
+        // The CLI's `--json`: the report with the survey section beside it.
+        let survey = eval::survey(&r, &e, &params).map_err(|e| {
+            CurbtraceError::new_err(format!(
+                "evaluating {extracted_name} against {reference_name}: {e}"
+            ))
+        })?;
+        let mut v: Value = serde_json::from_str(&report.to_json()).map_err(err)?;
+        v["survey"] = serde_json::to_value(&survey).map_err(err)?;
+        Ok(v.to_string())
     })
 }
 
