@@ -4,8 +4,8 @@
 #![no_main]
 
 use curbtrace_core::wire::{
-    scan, ConfigRepr, OutputHeaderRepr, OutputPointRepr, Packet, PointsRepr, Scan, StreamEncoder,
-    MAX_PACKET_LEN,
+    mark_link_checked, scan, ConfigRepr, OutputHeaderRepr, OutputPointRepr, Packet, PointsRepr,
+    Scan, StreamEncoder, MAX_PACKET_LEN,
 };
 use libfuzzer_sys::fuzz_target;
 
@@ -16,9 +16,14 @@ fuzz_target!(|data: &[u8]| {
             Scan::Empty => assert!(data.is_empty()),
             Scan::Packet { len } => {
                 assert!(len <= data.len());
-                // A packet found by scan has a valid envelope length and CRC.
+                // A packet found by scan has a valid envelope length and CRC, or is
+                // link-checked with its CRC field zero.
                 let p = Packet::new_checked(&data[..len]).expect("scan said packet");
-                assert_eq!(p.compute_crc(), p.crc());
+                if p.link_checked() {
+                    assert_eq!(p.crc(), 0);
+                } else {
+                    assert_eq!(p.compute_crc(), p.crc());
+                }
             }
             Scan::Garbage { len, .. } => assert!(len >= 1 && len <= data.len()),
             Scan::Incomplete => assert!(!at_end),
@@ -36,14 +41,19 @@ fuzz_target!(|data: &[u8]| {
     let len = p.length();
     let seq = p.seq();
     let mut out = [0u8; MAX_PACKET_LEN];
+    // A link-checked packet is the CRC'd packet with its field zeroed and flagged.
+    let lc = p.link_checked();
 
     if let Ok(r) = PointsRepr::parse(&p) {
         let n = r.emit(seq, &mut out).expect("a parsed points packet emits");
+        if lc {
+            mark_link_checked(&mut out[..n]);
+        }
         assert_eq!(&out[..n], &data[..len]);
         let again = PointsRepr::parse(&Packet::new_checked(&out[..n]).unwrap()).unwrap();
         assert_eq!(again, r);
         // The stream encoder writes the same bytes.
-        let mut enc = StreamEncoder::with_seq(seq);
+        let mut enc = StreamEncoder::with_seq(seq).link_checked(lc);
         let mut out2 = [0u8; MAX_PACKET_LEN];
         let n2 = enc
             .encode_points(r.base_time_ns, &r.points, &mut out2)
@@ -52,13 +62,16 @@ fuzz_target!(|data: &[u8]| {
     }
     if let Ok(r) = ConfigRepr::parse(&p) {
         let n = r.emit(seq, &mut out).expect("a parsed config packet emits");
+        if lc {
+            mark_link_checked(&mut out[..n]);
+        }
         assert_eq!(&out[..n], &data[..len]);
         let again = ConfigRepr::parse(&Packet::new_checked(&out[..n]).unwrap()).unwrap();
         assert_eq!(again, r);
     }
     if let Ok((h, pts)) = OutputHeaderRepr::parse(&p) {
         let pts: Vec<OutputPointRepr> = pts.collect();
-        let mut enc = StreamEncoder::with_seq(seq);
+        let mut enc = StreamEncoder::with_seq(seq).link_checked(lc);
         let n = enc
             .encode_output(&h, &pts, &mut out)
             .expect("a parsed output packet emits");
