@@ -19,11 +19,7 @@ fuzz_target!(|data: &[u8]| {
                 // A packet found by scan has a valid envelope length and CRC, or is
                 // link-checked with its CRC field zero.
                 let p = Packet::new_checked(&data[..len]).expect("scan said packet");
-                if p.link_checked() {
-                    assert_eq!(p.crc(), 0);
-                } else {
-                    assert_eq!(p.compute_crc(), p.crc());
-                }
+                assert!(p.compute_crc() == p.crc() || (p.link_checked() && p.crc() == 0));
             }
             Scan::Garbage { len, .. } => assert!(len >= 1 && len <= data.len()),
             Scan::Incomplete => assert!(!at_end),
