@@ -483,6 +483,51 @@ fn windows_sweeps_angles<M: Maths>(
     capped
 }
 
+/// Windows on sparse stretches of the smoothed line: where a point has no neighbour within
+/// d_b on a side (far from the scanner, where points lie farther apart than d_b), the
+/// adjacent point on that side becomes the window's end, unless a gap separates them (more
+/// than the smoothing gap apart; `gap2` is its square, 0 for no gaps); ρ is then taken on
+/// that window. Windows that reach a neighbour within d_b are left as they are. `s_off`
+/// and `t_off` are i − s(i) and t(i) − i as [`windows_angles`] leaves them.
+pub(crate) fn widen_sparse<M: Maths>(
+    x: &[f32],
+    z: &[f32],
+    gap2: f32,
+    s_off: &mut [u8],
+    t_off: &mut [u8],
+    rho: &mut [f32],
+) {
+    let n = x.len();
+    let (z, s_off, t_off, rho) = (&z[..n], &mut s_off[..n], &mut t_off[..n], &mut rho[..n]);
+    let joined = |a: usize, b: usize| gap2 <= 0.0 || dist2(x, z, a, b) <= gap2;
+    for j in 0..n {
+        let (so, to) = (s_off[j], t_off[j]);
+        if so != 0 && to != 0 {
+            continue;
+        }
+        let so = if so == 0 && j > 0 && joined(j - 1, j) { 1 } else { so };
+        let to = if to == 0 && j + 1 < n && joined(j, j + 1) { 1 } else { to };
+        s_off[j] = so;
+        t_off[j] = to;
+        if so != 0 && to != 0 {
+            rho[j] = bend_angle_deg::<M>(x, z, j - usize::from(so), j, j + usize::from(to));
+        }
+    }
+}
+
+/// Whether the d_b window [s, t] of a point is cut short by the end of its piece of line: the
+/// point before s or after t is missing (the line's end) or lies across a gap (more than the
+/// smoothing gap from the window's end; `gap2` is its square, 0 for no gaps). There the
+/// window's arm ends where the returns end, not where d_b ends, and the bend angle measures
+/// the direction to an arbitrary last return — at the edge of the shadow the vehicle's own
+/// body casts, where the scanline runs along the travel direction and the projected points
+/// pile up within millimetres, it reaches 90°.
+pub(crate) fn window_cut(x: &[f32], z: &[f32], gap2: f32, s: usize, t: usize) -> bool {
+    let n = x.len();
+    let gap = |a: usize, b: usize| gap2 > 0.0 && dist2(x, z, a, b) > gap2;
+    s == 0 || t + 1 >= n || gap(s - 1, s) || gap(t, t + 1)
+}
+
 /// Bit pattern of [`MAX_COORD_M`].
 const MAX_COORD_BITS: u32 = 0x44FA_0000;
 const _: () = assert!(MAX_COORD_M.to_bits() == MAX_COORD_BITS);

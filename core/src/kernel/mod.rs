@@ -132,6 +132,8 @@ pub struct ScanlineOutput<'a> {
 #[derive(Clone, Copy, Debug)]
 struct Derived {
     d2: f32,
+    /// The smoothing gap squared (0: lines are never split at gaps).
+    gap2: f32,
     irregular: bend::Threshold,
 }
 
@@ -139,12 +141,14 @@ impl Derived {
     /// Stands in until [`Derived::new`] has run (never used for a line).
     const PENDING: Self = Self {
         d2: 0.0,
+        gap2: 0.0,
         irregular: bend::Threshold::PENDING,
     };
 
     fn new(p: &KernelParams) -> Self {
         Self {
             d2: p.d_b_m * p.d_b_m,
+            gap2: p.smooth_gap_m * p.smooth_gap_m,
             irregular: bend::Threshold::new(p.irregular_deg),
         }
     }
@@ -227,7 +231,11 @@ impl<const N: usize> Kernel<N> {
         }
         let n = line.len.min(N);
         let p = self.params;
-        let Derived { d2, irregular } = self.derived;
+        let Derived {
+            d2,
+            gap2,
+            irregular,
+        } = self.derived;
         let mut c = KernelCounters {
             points_in: n as u32,
             ..KernelCounters::default()
@@ -277,12 +285,17 @@ impl<const N: usize> Kernel<N> {
         let s_off = &mut s_off[..kept];
         c.capped_windows +=
             bend::windows_angles::<M>(xk, zk, d2, s_off, &mut aux[..kept], &mut rho[..kept]);
+        // Sparse stretches (farther from the scanner than d_b covers): the adjacent point
+        // within the smoothing gap closes a window left empty.
+        bend::widen_sparse::<M>(xk, zk, gap2, s_off, &mut aux[..kept], &mut rho[..kept]);
         rho[kept..].fill(0.0);
 
         // 5. §2.6: nadir, peaks, candidates (compact indices).
         let nadir = seed::nadir(xk, zk);
         let seeds = seed::seed_candidates(
             xk,
+            zk,
+            gap2,
             &rho[..kept],
             s_off,
             &mut aux[..kept],
