@@ -5,11 +5,18 @@
 //! arc through both ends with the tangents measured there), the stretch between them is
 //! filled by that arc.
 //!
-//! Only the tracks themselves are read, so a bridge needs nothing beyond the window that
-//! holds both tracks.
+//! A bridge must run over measured ground: along most of it there are returns at the
+//! height of the line between the two ends. Where the line crosses an area the scanner did
+//! not see (behind a vehicle, the mouth of a side street seen past its corner) or runs
+//! through something standing on the road, nothing is bridged. Only the tracks and the
+//! points near the bridge are read, so a bridge needs nothing beyond the window that holds
+//! both tracks.
 
+use super::grid::PointGrid;
 use super::params::BendParams;
+use super::profile::usable;
 use super::track::Track;
+use super::BendInput;
 
 /// One end of a track: the vertex and the outward tangent (horizontal unit vector, pointing
 /// away from the track).
@@ -135,11 +142,50 @@ fn on_arc(a: [f64; 3], b: [f64; 3], alpha: f64, s: f64) -> [f64; 3] {
     ]
 }
 
+/// Spacing of the ground checks along a bridge, metres.
+const CHECK_STEP_M: f64 = 0.5;
+
+/// Horizontal radius and height band of the returns a ground check looks for, metres.
+const CHECK_RADIUS_M: f64 = 0.15;
+const CHECK_DZ_M: f64 = 0.1;
+
+/// Least share of a bridge's ground checks that must find returns.
+const CHECK_SHARE: f64 = 0.7;
+
+/// Whether the arc from `a` to `b` (see [`on_arc`]) runs over measured ground (see the
+/// module docs).
+fn on_ground(
+    input: &BendInput,
+    grid: &PointGrid,
+    a: [f64; 3],
+    b: [f64; 3],
+    alpha: f64,
+    d: f64,
+) -> bool {
+    let n = (d / CHECK_STEP_M).ceil().max(1.0) as usize;
+    let mut seen = 0usize;
+    for k in 1..n {
+        let q = on_arc(a, b, alpha, k as f64 / n as f64);
+        let mut found = false;
+        grid.for_each_within(input.x, input.y, q[0], q[1], CHECK_RADIUS_M, |i| {
+            found |= usable(input, i) && (input.z[i] - q[2]).abs() <= CHECK_DZ_M;
+        });
+        seen += usize::from(found);
+    }
+    n < 2 || seen as f64 >= CHECK_SHARE * (n - 1) as f64
+}
+
 /// Joins the tracks that continue each other across a stretch with nothing tracked (see the
 /// module docs), nearest pairs first. New vertices get ids from `next_id` on (ids at or past
 /// the number of points are vertices between measured points, as the tracker's virtual
 /// toes).
-pub fn bridge_tracks(tracks: Vec<Track>, mut next_id: u32, params: &BendParams) -> Vec<Track> {
+pub fn bridge_tracks(
+    input: &BendInput,
+    grid: &PointGrid,
+    tracks: Vec<Track>,
+    mut next_id: u32,
+    params: &BendParams,
+) -> Vec<Track> {
     if params.bridge_max_m <= 0.0 {
         return tracks;
     }
@@ -175,7 +221,7 @@ pub fn bridge_tracks(tracks: Vec<Track>, mut next_id: u32, params: &BendParams) 
                         .windows(2)
                         .any(|w| crosses(p, q, [w[0][0], w[0][1]], [w[1][0], w[1][1]]))
                 });
-                if !blocked {
+                if !blocked && on_ground(input, grid, a.xyz, b.xyz, alpha, d) {
                     best = Some((d, alpha, i, j));
                 }
             }
@@ -219,7 +265,9 @@ pub fn bridge_tracks(tracks: Vec<Track>, mut next_id: u32, params: &BendParams) 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::trajectory::Trajectory;
     use crate::model::Side;
+    use crate::replay::PointStatus;
 
     fn line(from: f64, to: f64, y: impl Fn(f64) -> f64, id0: u32) -> Track {
         let mut xyz = Vec::new();
@@ -235,60 +283,128 @@ mod tests {
         }
     }
 
+    /// Flat ground at z = 0, a return every 0.1 m over x in [−15, 45], y in [−2, 8],
+    /// except where `hole` says.
+    struct Ground {
+        x: Vec<f64>,
+        y: Vec<f64>,
+        z: Vec<f64>,
+        t: Vec<f64>,
+        rho: Vec<f32>,
+        status: Vec<Option<PointStatus>>,
+        scanline: Vec<u32>,
+        traj: Trajectory,
+    }
+
+    fn ground(hole: impl Fn(f64, f64) -> bool) -> Ground {
+        let mut g = Ground {
+            x: Vec::new(),
+            y: Vec::new(),
+            z: Vec::new(),
+            t: Vec::new(),
+            rho: Vec::new(),
+            status: Vec::new(),
+            scanline: Vec::new(),
+            traj: Trajectory::default(),
+        };
+        for i in 0..600 {
+            for j in 0..100 {
+                let (x, y) = (-15.0 + 0.1 * i as f64, -2.0 + 0.1 * j as f64);
+                if hole(x, y) {
+                    continue;
+                }
+                g.x.push(x);
+                g.y.push(y);
+                g.z.push(0.0);
+                g.t.push(g.t.len() as f64);
+                g.rho.push(0.0);
+                g.status.push(Some(PointStatus::Kept));
+                g.scanline.push(i);
+            }
+        }
+        g
+    }
+
+    fn bridge(g: &Ground, tracks: Vec<Track>) -> Vec<Track> {
+        let input = BendInput {
+            x: &g.x,
+            y: &g.y,
+            z: &g.z,
+            t: &g.t,
+            rho_deg: &g.rho,
+            status: &g.status,
+            scanline: &g.scanline,
+            candidates: &[],
+            trajectory: &g.traj,
+        };
+        let grid = PointGrid::build(&g.x, &g.y, 0.1, |_| true);
+        bridge_tracks(&input, &grid, tracks, 1_000_000, &BendParams::default())
+    }
+
     #[test]
     fn a_cut_between_two_aligned_curbs_is_bridged_on_the_line() {
-        let p = BendParams::default();
+        let g = ground(|_, _| false);
         // A straight curb along y = 5 with 8 m missing, the later piece given first.
         let tracks = vec![line(18.0, 30.0, |_| 5.0, 100), line(0.0, 10.0, |_| 5.0, 0)];
-        let out = bridge_tracks(tracks, 1000, &p);
+        let out = bridge(&g, tracks);
         assert_eq!(out.len(), 1);
         let t = &out[0];
         assert_eq!(t.points.len(), t.xyz.len());
         assert!(t.xyz.iter().all(|q| (q[1] - 5.0).abs() < 1e-9));
         // In driving order (x growing), from 0 to 30 without a hole over 0.15 m.
-        assert!(t.xyz.windows(2).all(|w| w[1][0] > w[0][0] && w[1][0] - w[0][0] < 0.151));
-        assert!(t.points.iter().any(|&id| id >= 1000));
+        assert!(t
+            .xyz
+            .windows(2)
+            .all(|w| w[1][0] > w[0][0] && w[1][0] - w[0][0] < 0.151));
+        assert!(t.points.iter().any(|&id| id >= 1_000_000));
     }
 
     #[test]
     fn an_arc_is_bridged_on_the_arc() {
-        let p = BendParams::default();
+        let g = ground(|_, _| false);
         // A 40 m radius arc about (0, 40): y = 40 − √(40² − x²).
         let r = 40.0f64;
         let arc = |x: f64| r - (r * r - x * x).sqrt();
         let tracks = vec![line(-12.0, -4.0, arc, 0), line(4.0, 12.0, arc, 100)];
-        let out = bridge_tracks(tracks, 1000, &p);
+        let out = bridge(&g, tracks);
         assert_eq!(out.len(), 1);
         let worst = out[0]
             .xyz
             .iter()
             .map(|q| (q[0].hypot(q[1] - r) - r).abs())
             .fold(0.0, f64::max);
-        assert!(worst < 0.02, "{worst}");
+        assert!(worst < 0.01, "{worst}");
     }
 
     #[test]
-    fn offset_far_crossing_and_opposite_sides_are_not_bridged() {
-        let p = BendParams::default();
+    fn offset_far_crossing_unseen_and_opposite_sides_are_not_bridged() {
+        let g = ground(|_, _| false);
         // The later piece 0.4 m off the line (a bus bay or a car's flank, not this curb).
         let off = vec![line(0.0, 10.0, |_| 5.0, 0), line(16.0, 30.0, |_| 5.4, 100)];
-        assert_eq!(bridge_tracks(off, 1000, &p).len(), 2);
+        assert_eq!(bridge(&g, off).len(), 2);
         // Too far apart.
         let far = vec![line(0.0, 10.0, |_| 5.0, 0), line(30.0, 40.0, |_| 5.0, 100)];
-        assert_eq!(bridge_tracks(far, 1000, &p).len(), 2);
+        assert_eq!(bridge(&g, far).len(), 2);
         // Another track crosses the gap.
         let mut across = line(0.0, 3.0, |_| 0.0, 200);
-        across.xyz.iter_mut().for_each(|q| *q = [14.0, q[0] + 3.5, 0.0]);
+        across
+            .xyz
+            .iter_mut()
+            .for_each(|q| *q = [14.0, q[0] + 3.5, 0.0]);
         let crossed = vec![
             line(0.0, 10.0, |_| 5.0, 0),
             line(18.0, 30.0, |_| 5.0, 100),
             across,
         ];
-        assert_eq!(bridge_tracks(crossed, 1000, &p).len(), 3);
+        assert_eq!(bridge(&g, crossed).len(), 3);
         // The other side of the road.
         let mut right = line(18.0, 30.0, |_| 5.0, 100);
         right.side = Side::Right;
         let sides = vec![line(0.0, 10.0, |_| 5.0, 0), right];
-        assert_eq!(bridge_tracks(sides, 1000, &p).len(), 2);
+        assert_eq!(bridge(&g, sides).len(), 2);
+        // No returns along the gap (an area the scanner did not see).
+        let unseen = ground(|x, _| (11.0..17.0).contains(&x));
+        let tracks = vec![line(0.0, 10.0, |_| 5.0, 0), line(18.0, 30.0, |_| 5.0, 100)];
+        assert_eq!(bridge(&unseen, tracks).len(), 2);
     }
 }

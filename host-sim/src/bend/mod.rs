@@ -133,7 +133,7 @@ pub fn extract_edges_on_route(
         .max()
         .map_or(0, |m| m.saturating_add(1))
         .max(input.x.len() as u32);
-    let tracks = bridge::bridge_tracks(tracks, next_id, params);
+    let tracks = bridge::bridge_tracks(&input, &grid, tracks, next_id, params);
     postfilter::to_edge_lines_with_steps(&input, &grid, route, &tracks, params)
 }
 
