@@ -144,6 +144,93 @@ fn ideal_curb_toe_is_plus_90_top_minus_90_in_all_orientations() {
     }
 }
 
+/// A line sparser than d_b: road every 0.1 m out to a step at x = 6 (face every 0.03 m up to
+/// 0.12 m), sidewalk every 0.1 m behind. Every window reaches only its adjacent points, and
+/// the toe is still the left candidate.
+#[test]
+fn sparse_points_take_their_adjacent_neighbours_and_the_toe_is_found() {
+    let mut v = Vec::new();
+    for i in 0..=60 {
+        v.push((0.1 * i as f32, -2.0));
+    }
+    for i in 1..=4 {
+        v.push((6.0, -2.0 + 0.03 * i as f32));
+    }
+    for i in 1..=20 {
+        v.push((6.0 + 0.1 * i as f32, -1.88));
+    }
+    let pts: Vec<(f32, f32, u32)> = v
+        .into_iter()
+        .enumerate()
+        .map(|(i, (x, z))| (x, z, i as u32))
+        .collect();
+    let params = KernelParams {
+        taubin_steps: 0,
+        ..KernelParams::DEFAULT
+    };
+    let mut k = Kernel::<N>::new(params);
+    let mut line = line_from(&pts);
+    let out = k.process(&mut line);
+    check_accounting(&out);
+    // Only the line's two ends lack a neighbour.
+    assert_eq!(out.counters.no_neighbour, 2);
+    assert_eq!(out.left, Some(60), "toe at x = 6");
+    assert!((out.rho_deg[60] - 90.0).abs() < 1.0, "{}", out.rho_deg[60]);
+    // With a gap of more than the smoothing gap before the toe, its window is cut: no
+    // candidate there.
+    let gapped: Vec<(f32, f32, u32)> = pts
+        .iter()
+        .map(|&(x, z, t)| (if t < 60 { x - 0.5 } else { x }, z, t))
+        .collect();
+    let mut line = line_from(&gapped);
+    let out = k.process(&mut line);
+    check_accounting(&out);
+    assert_eq!(out.left, None);
+}
+
+/// The edge of the shadow the vehicle's body casts, as a yawed scanline running along the
+/// travel direction gives it in x′: returns piling up within millimetres of x′ with the
+/// range noise in z′, then a gap of 2 m. The points next to the gap have a large ρ (their
+/// window's arm ends at the last return) but give no candidate; the curb beyond does.
+#[test]
+fn a_peak_at_the_edge_of_a_gap_is_no_candidate() {
+    let mut rng = Rng(7);
+    let mut v: Vec<(f32, f32)> = Vec::new();
+    for i in 0..200 {
+        v.push((0.005 * i as f32, -2.0));
+    }
+    // The pile-up before the shadow: x′ grows by 0.5 mm a return, z′ noisy by ±5 mm.
+    for i in 0..60 {
+        let noise = rng.range(-0.005, 0.005) as f32;
+        v.push((1.0 + 0.0005 * i as f32, -2.0 + noise));
+    }
+    // 2 m gap, then road out to a 0.15 m curb at x = 4.
+    for i in 0..=100 {
+        v.push((3.03 + 0.01 * i as f32, -2.0));
+    }
+    for i in 1..=15 {
+        v.push((4.03, -2.0 + 0.01 * i as f32));
+    }
+    for i in 1..=50 {
+        v.push((4.03 + 0.01 * i as f32, -1.85));
+    }
+    let pts: Vec<(f32, f32, u32)> = v
+        .into_iter()
+        .enumerate()
+        .map(|(i, (x, z))| (x, z, i as u32))
+        .collect();
+    let mut k = Kernel::<N>::new(KernelParams::DEFAULT);
+    let mut line = line_from(&pts);
+    let out = k.process(&mut line);
+    check_accounting(&out);
+    let left = usize::from(out.left.expect("a left candidate"));
+    assert!(
+        (out.x_m[left] - 4.03).abs() < 0.03,
+        "candidate at x′ = {}",
+        out.x_m[left]
+    );
+}
+
 #[test]
 fn spikes_are_removed_non_finite_set_aside_and_order_restored() {
     let mut pts = ideal_curb(false, false);
