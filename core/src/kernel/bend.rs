@@ -505,8 +505,16 @@ pub(crate) fn widen_sparse<M: Maths>(
         if so != 0 && to != 0 {
             continue;
         }
-        let so = if so == 0 && j > 0 && joined(j - 1, j) { 1 } else { so };
-        let to = if to == 0 && j + 1 < n && joined(j, j + 1) { 1 } else { to };
+        let so = if so == 0 && j > 0 && joined(j - 1, j) {
+            1
+        } else {
+            so
+        };
+        let to = if to == 0 && j + 1 < n && joined(j, j + 1) {
+            1
+        } else {
+            to
+        };
         s_off[j] = so;
         t_off[j] = to;
         if so != 0 && to != 0 {

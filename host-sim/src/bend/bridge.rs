@@ -243,10 +243,17 @@ pub fn bridge_tracks(
             bv.reverse();
         }
         // Keep the order of the longer piece (the driving direction, as the tracker gives it).
-        let flip = if av.len() >= bv.len() { !a.last } else { b.last };
+        let flip = if av.len() >= bv.len() {
+            !a.last
+        } else {
+            b.last
+        };
         let steps = (d / BRIDGE_STEP_M).ceil().max(1.0) as usize;
         for k in 1..steps {
-            av.push((next_id, on_arc(a.xyz, b.xyz, alpha, k as f64 / steps as f64)));
+            av.push((
+                next_id,
+                on_arc(a.xyz, b.xyz, alpha, k as f64 / steps as f64),
+            ));
             next_id = next_id.saturating_add(1);
         }
         av.extend(bv);
