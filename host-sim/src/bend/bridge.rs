@@ -397,7 +397,7 @@ mod tests {
         across
             .xyz
             .iter_mut()
-            .for_each(|q| *q = [14.0, q[0] + 3.5, 0.0]);
+            .for_each(|q| *q = [14.0, q[0] + 3.53, 0.0]);
         let crossed = vec![
             line(0.0, 10.0, |_| 5.0, 0),
             line(18.0, 30.0, |_| 5.0, 100),
