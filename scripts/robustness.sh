@@ -9,6 +9,8 @@
 # Seeds 1001-1030 are the evaluation streets; seeds 1-100 are for tuning. Streets run two
 # at a time, one thread each (both cores busy, no oversubscription). Work files go to
 # $ROBUSTNESS_OUT (default out/robustness), pictures to docs/robustness/.
+# ROBUSTNESS_METHODS (default "bend qiu") chooses the methods run; the page leaves the
+# figures of a method not run empty.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 N=${1:-30}
@@ -21,14 +23,15 @@ cargo build --release --quiet -p curbtrace-host-sim
 # A copy, so that a rebuild during the run cannot swap the binary under it.
 cp "${CARGO_TARGET_DIR:-target}/release/curbtrace" "$OUT/curbtrace"
 BIN=$(realpath "$OUT/curbtrace")
-export BIN OUT RAYON_NUM_THREADS=1
+METHODS=${ROBUSTNESS_METHODS:-bend qiu}
+export BIN OUT METHODS RAYON_NUM_THREADS=1
 
 one_street() { # seed
   local seed=$1 dir="$OUT/seed-$1" t0 t1
   mkdir -p "$dir"
   t0=$(date +%s%N)
   "$BIN" simulate --scene random --seed "$seed" -o "$dir" > "$dir/simulate.txt"
-  for method in bend qiu; do
+  for method in $METHODS; do
     local buffer=0.05
     [ "$method" = qiu ] && buffer=0.2
     t1=$(date +%s%N)

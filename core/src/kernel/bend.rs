@@ -483,6 +483,19 @@ fn windows_sweeps_angles<M: Maths>(
     capped
 }
 
+/// Whether the d_b window [s, t] of a point is cut short by the end of its piece of line: the
+/// point before s or after t is missing (the line's end) or lies across a gap (more than the
+/// smoothing gap from the window's end; `gap2` is its square, 0 for no gaps). There the
+/// window's arm ends where the returns end, not where d_b ends, and the bend angle measures
+/// the direction to an arbitrary last return — at the edge of the shadow the vehicle's own
+/// body casts, where the scanline runs along the travel direction and the projected points
+/// pile up within millimetres, it reaches 90°.
+pub(crate) fn window_cut(x: &[f32], z: &[f32], gap2: f32, s: usize, t: usize) -> bool {
+    let n = x.len();
+    let gap = |a: usize, b: usize| gap2 > 0.0 && dist2(x, z, a, b) > gap2;
+    s == 0 || t + 1 >= n || gap(s - 1, s) || gap(t, t + 1)
+}
+
 /// Bit pattern of [`MAX_COORD_M`].
 const MAX_COORD_BITS: u32 = 0x44FA_0000;
 const _: () = assert!(MAX_COORD_M.to_bits() == MAX_COORD_BITS);

@@ -148,6 +148,8 @@ pub struct ScanlineOutput<'a> {
 #[derive(Clone, Copy, Debug)]
 struct Derived {
     d2: f32,
+    /// The smoothing gap squared (0: lines are never split at gaps).
+    gap2: f32,
     irregular: bend::Threshold,
 }
 
@@ -155,12 +157,14 @@ impl Derived {
     /// Stands in until [`Derived::new`] has run (never used for a line).
     const PENDING: Self = Self {
         d2: 0.0,
+        gap2: 0.0,
         irregular: bend::Threshold::PENDING,
     };
 
     fn new(p: &KernelParams) -> Self {
         Self {
             d2: p.d_b_m * p.d_b_m,
+            gap2: p.smooth_gap_m * p.smooth_gap_m,
             irregular: bend::Threshold::new(p.irregular_deg),
         }
     }
@@ -244,7 +248,11 @@ impl<const N: usize> Kernel<N> {
         }
         let n_all = line.len.min(N);
         let p = self.params;
-        let Derived { d2, irregular } = self.derived;
+        let Derived {
+            d2,
+            gap2,
+            irregular,
+        } = self.derived;
         // 0. The points inside the region of interest to the front, in order.
         let n = match p.roi() {
             Some(roi) => roi_partition(
@@ -311,6 +319,8 @@ impl<const N: usize> Kernel<N> {
         let nadir = seed::nadir(xk, zk);
         let seeds = seed::seed_candidates(
             xk,
+            zk,
+            gap2,
             &rho[..kept],
             s_off,
             &mut aux[..kept],

@@ -234,12 +234,13 @@ pub struct KernelParams {
     pub irregular_deg: f32,
     /// τ_ρmin: lower bound (exclusive) of the bend angle of a peak, degrees (§2.6).
     ///
-    /// Default 35° — not given by the paper ("close to 90 degrees"). Far below the toe of
-    /// any curb taller than d_b (≈90°, somewhat less after smoothing rounds the corner) and
-    /// below a 40 mm step's asin(0.04/0.07) ≈ 35°, yet well above road crown, ruts and the
-    /// 5 mm noise left after smoothing (a few degrees; the synthetic lines of
-    /// `kernel::tests` give no false candidate). Curb cuts (20–30 mm steps, ρ ≈ 17–25°)
-    /// give no peak; the host tracks through them (§2.7).
+    /// Default 30° — not given by the paper ("close to 90 degrees"). Far below the toe of
+    /// any curb taller than d_b (≈90°, somewhat less after smoothing rounds the corner),
+    /// low enough for the toe of a 60–80 mm curb far from the scanner, where the returns
+    /// lie farther apart than d_b and smoothing rounds the corner to 30–35°, yet well above
+    /// road crown, ruts and the 5 mm noise left after smoothing (a few degrees; the
+    /// synthetic lines of `kernel::tests` give no false candidate). Curb cuts (20–30 mm
+    /// steps, ρ ≈ 17–25°) give no peak; the host tracks and bridges through them (§2.7).
     pub tau_min_deg: f32,
     /// τ_ρmax: upper bound (exclusive) of the bend angle of a peak, degrees (§2.6).
     ///
@@ -338,7 +339,7 @@ impl KernelParams {
     pub const DEFAULT: Self = Self {
         d_b_m: 0.07,
         irregular_deg: 120.0,
-        tau_min_deg: 35.0,
+        tau_min_deg: 30.0,
         tau_max_deg: 150.0,
         taubin_steps: 20,
         taubin_lambda: 0.6307,
@@ -590,7 +591,7 @@ mod tests {
             (Param::IrregularDeg, f32::INFINITY.to_bits()),
             (Param::IrregularDeg, 181.0f32.to_bits()),
             (Param::TauMinDeg, (-1.0f32).to_bits()),
-            (Param::TauMaxDeg, 30.0f32.to_bits()), // below τ_min = 35
+            (Param::TauMaxDeg, 25.0f32.to_bits()), // below τ_min = 30
             (Param::TaubinSteps, 201),
             (Param::TaubinLambda, 1.5f32.to_bits()),
             (Param::TaubinMu, 0.5f32.to_bits()),

@@ -185,6 +185,24 @@ pub fn run(x0: &[f64], z0: &[f64], p: &KernelParams) -> RefOut {
 
     // ρ on the smoothed line.
     let (s, t) = windows(&x, &z, d_b, &mut margin_m);
+    // Distances against the smoothing gap (0: no gaps), on smoothed points: recorded in the
+    // margin.
+    let apart = |a: usize, b: usize, margin_m: &mut f64| {
+        if gap <= 0.0 {
+            return false;
+        }
+        let g = dist(&x, &z, a, b);
+        *margin_m = margin_m.min((g - gap).abs());
+        g > gap
+    };
+    // A window cut short by the line's end or a gap gives no candidate.
+    let mut cut = std::vec![false; k];
+    for j in 0..k {
+        cut[j] = s[j] == 0
+            || t[j] + 1 >= k
+            || apart(s[j] - 1, s[j], &mut margin_m)
+            || apart(t[j], t[j] + 1, &mut margin_m);
+    }
     let has = |j: usize| s[j] < j && t[j] > j;
     let r: Vec<f64> = (0..k)
         .map(|j| {
@@ -235,7 +253,7 @@ pub fn run(x0: &[f64], z0: &[f64], p: &KernelParams) -> RefOut {
                 cands.swap(0, 1);
             }
             for c in cands {
-                if !peak[c] {
+                if !peak[c] || cut[c] {
                     continue;
                 }
                 if x[c] > 0.0 && left.is_none() {

@@ -7,7 +7,8 @@
 //! - Candidates: walking outward from the nadir in scan order (both ways at once), the
 //!   first peak with x′ > 0 is the left candidate and the first with x′ < 0 the right one.
 //!   "First" is the smallest |k − nadir|; a tie between the two directions goes to the
-//!   smaller |x′| (nearer the vehicle), then the lower index.
+//!   smaller |x′| (nearer the vehicle), then the lower index. A peak whose window is cut
+//!   short by a gap or the line's end ([`super::bend::window_cut`]) is passed over.
 //!
 //! The window maximum comes from a monotone deque over the same two-index windows as ρ
 //! (both ends only move forward), fed lazily (see [`seed_candidates`]), so the whole pass
@@ -59,6 +60,8 @@ pub(crate) struct Seeds {
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn seed_candidates(
     x: &[f32],
+    z: &[f32],
+    gap2: f32,
     rho: &[f32],
     s_off: &[u8],
     aux: &mut [u8],
@@ -115,6 +118,10 @@ pub(crate) fn seed_candidates(
         }
         out.peaks += 1;
         let Some(nd) = nadir else { continue };
+        // A window cut short by a gap or the line's end gives no candidate (rare: peaks only).
+        if super::bend::window_cut(x, z, gap2, s, t) {
+            continue;
+        }
         let xk = x[k];
         let dist = k.abs_diff(nd);
         let ax = crate::math::abs(xk);
@@ -158,6 +165,8 @@ mod tests {
         let mut dq = [0u16; DEQUE_LEN];
         let seeds = seed_candidates(
             x,
+            &z[..n],
+            0.09,
             rho,
             &s_off[..n],
             &mut aux[..n],

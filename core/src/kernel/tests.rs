@@ -145,6 +145,49 @@ fn ideal_curb_toe_is_plus_90_top_minus_90_in_all_orientations() {
     }
 }
 
+/// The edge of the shadow the vehicle's body casts, as a yawed scanline running along the
+/// travel direction gives it in x′: returns piling up within millimetres of x′ with the
+/// range noise in z′, then a gap of 2 m. The points next to the gap have a large ρ (their
+/// window's arm ends at the last return) but give no candidate; the curb beyond does.
+#[test]
+fn a_peak_at_the_edge_of_a_gap_is_no_candidate() {
+    let mut rng = Rng(7);
+    let mut v: Vec<(f32, f32)> = Vec::new();
+    for i in 0..200 {
+        v.push((0.005 * i as f32, -2.0));
+    }
+    // The pile-up before the shadow: x′ grows by 0.5 mm a return, z′ noisy by ±5 mm.
+    for i in 0..60 {
+        let noise = rng.range(-0.005, 0.005) as f32;
+        v.push((1.0 + 0.0005 * i as f32, -2.0 + noise));
+    }
+    // 2 m gap, then road out to a 0.15 m curb at x = 4.
+    for i in 0..=100 {
+        v.push((3.03 + 0.01 * i as f32, -2.0));
+    }
+    for i in 1..=15 {
+        v.push((4.03, -2.0 + 0.01 * i as f32));
+    }
+    for i in 1..=50 {
+        v.push((4.03 + 0.01 * i as f32, -1.85));
+    }
+    let pts: Vec<(f32, f32, u32)> = v
+        .into_iter()
+        .enumerate()
+        .map(|(i, (x, z))| (x, z, i as u32))
+        .collect();
+    let mut k = Kernel::<N>::new(KernelParams::DEFAULT);
+    let mut line = line_from(&pts);
+    let out = k.process(&mut line);
+    check_accounting(&out);
+    let left = usize::from(out.left.expect("a left candidate"));
+    assert!(
+        (out.x_m[left] - 4.03).abs() < 0.03,
+        "candidate at x′ = {}",
+        out.x_m[left]
+    );
+}
+
 #[test]
 fn spikes_are_removed_non_finite_set_aside_and_order_restored() {
     let mut pts = ideal_curb(false, false);

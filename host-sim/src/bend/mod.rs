@@ -1,6 +1,7 @@
 //! The bend-angle method's host half (Honma et al. §2.6–2.7): seeding by RANSAC per
 //! interval ([`seed`]), tracking by the energy of Eq. 4–8 ([`track`]), post-filters and
-//! the edges' properties ([`postfilter`]). It reads the core's output as it is (its ρ and
+//! the edges' properties ([`postfilter`]), bridges between tracks that continue each other
+//! ([`bridge`]). It reads the core's output as it is (its ρ and
 //! its candidates) and never recomputes them.
 //!
 //! Everything here is sequential and uses only seeded randomness, so the output is the same
@@ -10,6 +11,7 @@ use crate::io::trajectory::Trajectory;
 use crate::model::EdgeLine;
 use crate::replay::{Candidate, PointStatus};
 
+pub mod bridge;
 pub mod claims;
 pub mod grid;
 pub mod params;
@@ -124,6 +126,14 @@ pub fn extract_edges_on_route(
     } else {
         tracks
     };
+    // Virtual vertices of the bridges count on from the tracker's.
+    let next_id = tracks
+        .iter()
+        .flat_map(|t| t.points.iter().copied())
+        .max()
+        .map_or(0, |m| m.saturating_add(1))
+        .max(input.x.len() as u32);
+    let tracks = bridge::bridge_tracks(&input, &grid, tracks, next_id, params);
     postfilter::to_edge_lines_with_steps(&input, &grid, route, &tracks, params)
 }
 

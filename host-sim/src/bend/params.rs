@@ -102,6 +102,23 @@ pub struct BendParams {
     /// half the search radius.
     pub join_distance_m: f64,
 
+    // ---- Bridges (bridge.rs) ----
+    /// Longest stretch between two tracks of one side that continue each other and are
+    /// joined by the arc through their ends, metres (0 = no bridges). Not in the paper; curb
+    /// cuts run 3–12 m and hide their toe from the bend angle when their lip is low, a
+    /// parked car hides 4–6 m of curb; side streets open 12 m and more between their
+    /// corners' tangent points.
+    pub bridge_max_m: f64,
+    /// Largest angle between the chord of a bridge and the tangent at either end, degrees.
+    /// Not in the paper; a 12 m bridge on a 30 m radius turns by 11° at each end.
+    pub bridge_max_turn_deg: f64,
+    /// Lateral offset over the bridge that the two tangents may disagree by, metres. Not in
+    /// the paper; a car's flank or a bus bay's edge lies 0.2 m or more beside the curb's line.
+    pub bridge_offset_m: f64,
+    /// Angle the two tangents may disagree by besides, degrees: the scatter of tangents
+    /// taken over 2 m of tracked toe. Not in the paper.
+    pub bridge_tangent_tol_deg: f64,
+
     // ---- Post-filters (end of §2.7) ----
     /// Edges shorter than this are removed, metres. Not in the paper; 1 m is shorter than
     /// any curb stretch worth mapping and longer than most spurious tracks on cars.
@@ -180,6 +197,10 @@ impl Default for BendParams {
             profile_max_slope: 0.1,
             max_steps: 200_000,
             join_distance_m: 0.05,
+            bridge_max_m: 12.0,
+            bridge_max_turn_deg: 20.0,
+            bridge_offset_m: 0.1,
+            bridge_tangent_tol_deg: 0.5,
             min_edge_length_m: 1.0,
             vehicle_band_low_m: 0.4,
             vehicle_band_high_m: 2.0,

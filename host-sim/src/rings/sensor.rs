@@ -21,6 +21,11 @@ use curbtrace_core::kernel::KernelParams;
 pub const D_B_RANGE_M: f32 = 15.0;
 /// Spacings d_b spans at [`D_B_RANGE_M`].
 pub const D_B_SPACINGS: f32 = 1.5;
+/// τ_ρmin on rings, degrees: above the profiler default. A profiler's candidates at a low
+/// step (d_b·sin τ_min high) are confirmed by tracking over hundreds of scanlines; a ring
+/// frame crosses a curb with a handful of half-arcs, so a peak must be a step of at least
+/// d_b·sin 35° (40 mm at d_b = 0.07 m) to count.
+pub const RING_TAU_MIN_DEG: f32 = 35.0;
 
 /// A spinning lidar: what the ring-to-scanline rule needs to know about it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -94,7 +99,7 @@ impl SensorModel {
     }
 
     /// The kernel parameters for this sensor: the defaults with d_b from the azimuth step
-    /// (module docs), the line split left to the half-arcs' line-start flags (no split on
+    /// (module docs), τ_ρmin at [`RING_TAU_MIN_DEG`], the line split left to the half-arcs' line-start flags (no split on
     /// time gaps shorter than a revolution: a half-arc may skip the sector the vehicle
     /// hides) and never on geometry.
     pub fn kernel_params(&self) -> KernelParams {
@@ -102,6 +107,7 @@ impl SensorModel {
         let d_b = d.d_b_m.max(D_B_SPACINGS * self.spacing_m(D_B_RANGE_M));
         KernelParams {
             d_b_m: round_mm(d_b),
+            tau_min_deg: RING_TAU_MIN_DEG,
             split_gap_ns: (1e9 / self.rate_hz) as u32,
             split_geometry: 2,
             ..d

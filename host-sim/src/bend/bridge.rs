@@ -1,0 +1,417 @@
+//! Bridges across stretches where the toe gives the tracker nothing to follow: curb cuts
+//! whose lip is too low for a bend angle (the toe is only a change of slope there) and curb
+//! hidden behind a parked vehicle. The curb on either side is tracked; where two tracks of
+//! one side end facing each other, and continue each other's line (a straight or a circular
+//! arc through both ends with the tangents measured there), the stretch between them is
+//! filled by that arc.
+//!
+//! A bridge must run over measured ground: along most of it there are returns at the
+//! height of the line between the two ends. Where the line crosses an area the scanner did
+//! not see (behind a vehicle, the mouth of a side street seen past its corner) or runs
+//! through something standing on the road, nothing is bridged. Only the tracks and the
+//! points near the bridge are read, so a bridge needs nothing beyond the window that holds
+//! both tracks.
+
+use super::grid::PointGrid;
+use super::params::BendParams;
+use super::profile::usable;
+use super::track::Track;
+use super::BendInput;
+
+/// One end of a track: the vertex and the outward tangent (horizontal unit vector, pointing
+/// away from the track).
+#[derive(Clone, Copy, Debug)]
+struct End {
+    track: usize,
+    /// Whether this is the track's last vertex (else its first).
+    last: bool,
+    xyz: [f64; 3],
+    out: [f64; 2],
+    /// Length of track the tangent was taken over, metres.
+    span: f64,
+}
+
+/// Track length from an end over which its tangent is taken, metres: long enough to average
+/// the vertices' scatter, short enough to follow a 30 m radius.
+const TANGENT_SPAN_M: f64 = 2.0;
+
+/// Spacing of the vertices put on a bridge, metres (the tracker's search distance).
+const BRIDGE_STEP_M: f64 = 0.15;
+
+/// The end of `t` (its last vertex when `last`) with its outward tangent over
+/// [`TANGENT_SPAN_M`] of track; `None` when the track is shorter than half of that.
+fn end_of(t: &Track, track: usize, last: bool) -> Option<End> {
+    let n = t.xyz.len();
+    if n < 2 {
+        return None;
+    }
+    let at = |k: usize| if last { t.xyz[n - 1 - k] } else { t.xyz[k] };
+    let e = at(0);
+    let mut far = None;
+    let mut along = 0.0;
+    for k in 1..n {
+        let (a, b) = (at(k - 1), at(k));
+        along += (b[0] - a[0]).hypot(b[1] - a[1]);
+        far = Some(b);
+        if along >= TANGENT_SPAN_M {
+            break;
+        }
+    }
+    let f = far?;
+    if along < 0.5 * TANGENT_SPAN_M {
+        return None;
+    }
+    let (dx, dy) = (e[0] - f[0], e[1] - f[1]);
+    let l = dx.hypot(dy);
+    (l > 1e-6).then(|| End {
+        track,
+        last,
+        xyz: e,
+        out: [dx / l, dy / l],
+        span: along,
+    })
+}
+
+/// Signed angle from unit vector `a` to unit vector `b`, radians.
+fn angle(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] * b[1] - a[1] * b[0]).atan2(a[0] * b[0] + a[1] * b[1])
+}
+
+/// Whether segments ab and cd cross.
+fn crosses(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
+    let orient = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+    };
+    let (d1, d2) = (orient(c, d, a), orient(c, d, b));
+    let (d3, d4) = (orient(a, b, c), orient(a, b, d));
+    d1 * d2 < 0.0 && d3 * d4 < 0.0
+}
+
+/// How well ends `a` and `b` continue each other: the bridge's length and the angle from
+/// the chord a → b to the arc's tangent at `a` (left positive), when they face each other
+/// across at most `bridge_max_m` and a straight or circular arc through both fits their
+/// tangents (the turn from the chord at `a` mirrors the one at `b`, to within the angle a
+/// lateral offset of `bridge_offset_m` makes over the chord).
+fn fit(a: &End, b: &End, params: &BendParams) -> Option<(f64, f64)> {
+    let c = [b.xyz[0] - a.xyz[0], b.xyz[1] - a.xyz[1]];
+    let d = c[0].hypot(c[1]);
+    if d < 1e-6 || d > params.bridge_max_m {
+        return None;
+    }
+    let u = [c[0] / d, c[1] / d];
+    // For an arc, a's outward tangent turns from the chord by −φ and b's from the reversed
+    // chord by +φ.
+    let pa = angle(u, a.out);
+    let pb = angle([-u[0], -u[1]], b.out);
+    let max_turn = params.bridge_max_turn_deg.to_radians();
+    if pa.abs() > max_turn || pb.abs() > max_turn {
+        return None;
+    }
+    let tol = 2.0 * params.bridge_offset_m / d + params.bridge_tangent_tol_deg.to_radians();
+    if (pa + pb).abs() > tol {
+        return None;
+    }
+    // Each tangent is the chord of the track over its span, which on an arc turns from the
+    // chord a → b by (d + span) / 2R rather than d / 2R.
+    let span = 0.5 * (a.span + b.span);
+    Some((d, 0.5 * (pa - pb) * d / (d + span)))
+}
+
+/// The point at fraction `s` of the circular arc from `a` to `b` whose tangent at `a` turns
+/// `alpha` from the chord (left positive; 0: the straight chord).
+fn on_arc(a: [f64; 3], b: [f64; 3], alpha: f64, s: f64) -> [f64; 3] {
+    let z = a[2] + s * (b[2] - a[2]);
+    let c = [b[0] - a[0], b[1] - a[1]];
+    if alpha.abs() < 1e-6 {
+        return [a[0] + s * c[0], a[1] + s * c[1], z];
+    }
+    let d = c[0].hypot(c[1]);
+    let (u, n) = ([c[0] / d, c[1] / d], [-c[1] / d, c[0] / d]);
+    // Chord-centred coordinates: along = R sin ψ, across = R (cos ψ − cos φ) towards the
+    // bulge, for ψ from −φ to φ.
+    let phi = alpha.abs();
+    let r = d / (2.0 * phi.sin());
+    let psi = -phi + 2.0 * phi * s;
+    let along = r * psi.sin();
+    let across = alpha.signum() * r * (psi.cos() - phi.cos());
+    let m = [a[0] + 0.5 * c[0], a[1] + 0.5 * c[1]];
+    [
+        m[0] + along * u[0] + across * n[0],
+        m[1] + along * u[1] + across * n[1],
+        z,
+    ]
+}
+
+/// Spacing of the ground checks along a bridge, metres.
+const CHECK_STEP_M: f64 = 0.5;
+
+/// Horizontal radius and height band of the returns a ground check looks for, metres.
+const CHECK_RADIUS_M: f64 = 0.15;
+const CHECK_DZ_M: f64 = 0.1;
+
+/// Least share of a bridge's ground checks that must find returns.
+const CHECK_SHARE: f64 = 0.7;
+
+/// Whether the arc from `a` to `b` (see [`on_arc`]) runs over measured ground (see the
+/// module docs).
+fn on_ground(
+    input: &BendInput,
+    grid: &PointGrid,
+    a: [f64; 3],
+    b: [f64; 3],
+    alpha: f64,
+    d: f64,
+) -> bool {
+    let n = (d / CHECK_STEP_M).ceil().max(1.0) as usize;
+    let mut seen = 0usize;
+    for k in 1..n {
+        let q = on_arc(a, b, alpha, k as f64 / n as f64);
+        let mut found = false;
+        grid.for_each_within(input.x, input.y, q[0], q[1], CHECK_RADIUS_M, |i| {
+            found |= usable(input, i) && (input.z[i] - q[2]).abs() <= CHECK_DZ_M;
+        });
+        seen += usize::from(found);
+    }
+    n < 2 || seen as f64 >= CHECK_SHARE * (n - 1) as f64
+}
+
+/// Joins the tracks that continue each other across a stretch with nothing tracked (see the
+/// module docs), nearest pairs first. New vertices get ids from `next_id` on (ids at or past
+/// the number of points are vertices between measured points, as the tracker's virtual
+/// toes).
+pub fn bridge_tracks(
+    input: &BendInput,
+    grid: &PointGrid,
+    tracks: Vec<Track>,
+    mut next_id: u32,
+    params: &BendParams,
+) -> Vec<Track> {
+    if params.bridge_max_m <= 0.0 {
+        return tracks;
+    }
+    let mut tracks: Vec<Option<Track>> = tracks.into_iter().map(Some).collect();
+    loop {
+        let ends: Vec<End> = tracks
+            .iter()
+            .enumerate()
+            .filter_map(|(k, t)| t.as_ref().map(|t| (k, t)))
+            .flat_map(|(k, t)| [end_of(t, k, false), end_of(t, k, true)])
+            .flatten()
+            .collect();
+        let mut best: Option<(f64, f64, usize, usize)> = None;
+        for (i, a) in ends.iter().enumerate() {
+            for (j, b) in ends.iter().enumerate().skip(i + 1) {
+                let (ta, tb) = (&tracks[a.track], &tracks[b.track]);
+                let (Some(ta), Some(tb)) = (ta, tb) else {
+                    continue;
+                };
+                if a.track == b.track || ta.side != tb.side {
+                    continue;
+                }
+                let Some((d, alpha)) = fit(a, b, params) else {
+                    continue;
+                };
+                if best.is_some_and(|(bd, _, _, _)| bd <= d) {
+                    continue;
+                }
+                // No other track may cross the bridge's chord.
+                let (p, q) = ([a.xyz[0], a.xyz[1]], [b.xyz[0], b.xyz[1]]);
+                let blocked = tracks.iter().flatten().any(|t| {
+                    t.xyz
+                        .windows(2)
+                        .any(|w| crosses(p, q, [w[0][0], w[0][1]], [w[1][0], w[1][1]]))
+                });
+                if !blocked && on_ground(input, grid, a.xyz, b.xyz, alpha, d) {
+                    best = Some((d, alpha, i, j));
+                }
+            }
+        }
+        let Some((d, alpha, i, j)) = best else {
+            break;
+        };
+        let (a, b) = (ends[i], ends[j]);
+        let (Some(ta), Some(tb)) = (tracks[a.track].take(), tracks[b.track].take()) else {
+            break;
+        };
+        // a's track ending at a, then the bridge, then b's track starting at b.
+        let mut av: Vec<(u32, [f64; 3])> = ta.points.iter().copied().zip(ta.xyz).collect();
+        let mut bv: Vec<(u32, [f64; 3])> = tb.points.iter().copied().zip(tb.xyz).collect();
+        if !a.last {
+            av.reverse();
+        }
+        if b.last {
+            bv.reverse();
+        }
+        // Keep the order of the longer piece (the driving direction, as the tracker gives it).
+        let flip = if av.len() >= bv.len() {
+            !a.last
+        } else {
+            b.last
+        };
+        let steps = (d / BRIDGE_STEP_M).ceil().max(1.0) as usize;
+        for k in 1..steps {
+            av.push((
+                next_id,
+                on_arc(a.xyz, b.xyz, alpha, k as f64 / steps as f64),
+            ));
+            next_id = next_id.saturating_add(1);
+        }
+        av.extend(bv);
+        if flip {
+            av.reverse();
+        }
+        tracks[a.track] = Some(Track {
+            points: av.iter().map(|v| v.0).collect(),
+            xyz: av.iter().map(|v| v.1).collect(),
+            side: ta.side,
+        });
+    }
+    tracks.into_iter().flatten().collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::io::trajectory::Trajectory;
+    use crate::model::Side;
+    use crate::replay::PointStatus;
+
+    fn line(from: f64, to: f64, y: impl Fn(f64) -> f64, id0: u32) -> Track {
+        let mut xyz = Vec::new();
+        let mut x = from;
+        while x <= to + 1e-9 {
+            xyz.push([x, y(x), 0.0]);
+            x += 0.15;
+        }
+        Track {
+            points: (id0..id0 + xyz.len() as u32).collect(),
+            xyz,
+            side: Side::Left,
+        }
+    }
+
+    /// Flat ground at z = 0, a return every 0.1 m over x in [−15, 45], y in [−2, 8],
+    /// except where `hole` says.
+    struct Ground {
+        x: Vec<f64>,
+        y: Vec<f64>,
+        z: Vec<f64>,
+        t: Vec<f64>,
+        rho: Vec<f32>,
+        status: Vec<Option<PointStatus>>,
+        scanline: Vec<u32>,
+        traj: Trajectory,
+    }
+
+    fn ground(hole: impl Fn(f64, f64) -> bool) -> Ground {
+        let mut g = Ground {
+            x: Vec::new(),
+            y: Vec::new(),
+            z: Vec::new(),
+            t: Vec::new(),
+            rho: Vec::new(),
+            status: Vec::new(),
+            scanline: Vec::new(),
+            traj: Trajectory::default(),
+        };
+        for i in 0..600 {
+            for j in 0..100 {
+                let (x, y) = (-15.0 + 0.1 * i as f64, -2.0 + 0.1 * j as f64);
+                if hole(x, y) {
+                    continue;
+                }
+                g.x.push(x);
+                g.y.push(y);
+                g.z.push(0.0);
+                g.t.push(g.t.len() as f64);
+                g.rho.push(0.0);
+                g.status.push(Some(PointStatus::Kept));
+                g.scanline.push(i);
+            }
+        }
+        g
+    }
+
+    fn bridge(g: &Ground, tracks: Vec<Track>) -> Vec<Track> {
+        let input = BendInput {
+            x: &g.x,
+            y: &g.y,
+            z: &g.z,
+            t: &g.t,
+            rho_deg: &g.rho,
+            status: &g.status,
+            scanline: &g.scanline,
+            candidates: &[],
+            trajectory: &g.traj,
+        };
+        let grid = PointGrid::build(&g.x, &g.y, 0.1, |_| true);
+        bridge_tracks(&input, &grid, tracks, 1_000_000, &BendParams::default())
+    }
+
+    #[test]
+    fn a_cut_between_two_aligned_curbs_is_bridged_on_the_line() {
+        let g = ground(|_, _| false);
+        // A straight curb along y = 5 with 8 m missing, the later piece given first.
+        let tracks = vec![line(18.0, 30.0, |_| 5.0, 100), line(0.0, 10.0, |_| 5.0, 0)];
+        let out = bridge(&g, tracks);
+        assert_eq!(out.len(), 1);
+        let t = &out[0];
+        assert_eq!(t.points.len(), t.xyz.len());
+        assert!(t.xyz.iter().all(|q| (q[1] - 5.0).abs() < 1e-9));
+        // In driving order (x growing), from 0 to 30 without a hole over 0.15 m.
+        assert!(t
+            .xyz
+            .windows(2)
+            .all(|w| w[1][0] > w[0][0] && w[1][0] - w[0][0] < 0.151));
+        assert!(t.points.iter().any(|&id| id >= 1_000_000));
+    }
+
+    #[test]
+    fn an_arc_is_bridged_on_the_arc() {
+        let g = ground(|_, _| false);
+        // A 40 m radius arc about (0, 40): y = 40 − √(40² − x²).
+        let r = 40.0f64;
+        let arc = |x: f64| r - (r * r - x * x).sqrt();
+        let tracks = vec![line(-12.0, -4.0, arc, 0), line(4.0, 12.0, arc, 100)];
+        let out = bridge(&g, tracks);
+        assert_eq!(out.len(), 1);
+        let worst = out[0]
+            .xyz
+            .iter()
+            .map(|q| (q[0].hypot(q[1] - r) - r).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 0.01, "{worst}");
+    }
+
+    #[test]
+    fn offset_far_crossing_unseen_and_opposite_sides_are_not_bridged() {
+        let g = ground(|_, _| false);
+        // The later piece 0.4 m off the line (a bus bay or a car's flank, not this curb).
+        let off = vec![line(0.0, 10.0, |_| 5.0, 0), line(16.0, 30.0, |_| 5.4, 100)];
+        assert_eq!(bridge(&g, off).len(), 2);
+        // Too far apart.
+        let far = vec![line(0.0, 10.0, |_| 5.0, 0), line(30.0, 40.0, |_| 5.0, 100)];
+        assert_eq!(bridge(&g, far).len(), 2);
+        // Another track crosses the gap.
+        let mut across = line(0.0, 3.0, |_| 0.0, 200);
+        across
+            .xyz
+            .iter_mut()
+            .for_each(|q| *q = [14.0, q[0] + 3.53, 0.0]);
+        let crossed = vec![
+            line(0.0, 10.0, |_| 5.0, 0),
+            line(18.0, 30.0, |_| 5.0, 100),
+            across,
+        ];
+        assert_eq!(bridge(&g, crossed).len(), 3);
+        // The other side of the road.
+        let mut right = line(18.0, 30.0, |_| 5.0, 100);
+        right.side = Side::Right;
+        let sides = vec![line(0.0, 10.0, |_| 5.0, 0), right];
+        assert_eq!(bridge(&g, sides).len(), 2);
+        // No returns along the gap (an area the scanner did not see).
+        let unseen = ground(|x, _| (11.0..17.0).contains(&x));
+        let tracks = vec![line(0.0, 10.0, |_| 5.0, 0), line(18.0, 30.0, |_| 5.0, 100)];
+        assert_eq!(bridge(&unseen, tracks).len(), 2);
+    }
+}
