@@ -4,7 +4,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
-step() { printf '\n==> %s\n' "$*"; }
+# Each step prints the minutes since the run began, so a slow step shows in CI's log.
+T0=${CURBTRACE_T0:-$(date +%s)}; export CURBTRACE_T0=$T0
+step() { printf '\n==> [%dm%02ds] %s\n' $((($(date +%s) - T0) / 60)) $((($(date +%s) - T0) % 60)) "$*"; }
 step "fuzz: cargo fmt --check and clippy on the fuzz crate (-D warnings)"
 command -v cargo-fuzz >/dev/null 2>&1 || cargo install cargo-fuzz --locked
 if rustup run nightly rustc --version >/dev/null 2>&1; then

@@ -6,7 +6,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
 
-step() { printf '\n==> %s\n' "$*"; }
+# Each step prints the minutes since the run began, so a slow step shows in CI's log.
+T0=${CURBTRACE_T0:-$(date +%s)}; export CURBTRACE_T0=$T0
+step() { printf '\n==> [%dm%02ds] %s\n' $((($(date +%s) - T0) / 60)) $((($(date +%s) - T0) % 60)) "$*"; }
 
 # --- tools -----------------------------------------------------------------------------
 need_apt=()
@@ -124,4 +126,4 @@ fi
 ./scripts/fuzz-smoke.sh
 
 echo
-echo "all checks passed"
+step "all checks passed"
