@@ -84,12 +84,12 @@ fn random_streets_run_through_the_product_with_sane_totals() {
     }
     // Just under what the defaults reach on these streets (docs/results.md).
     for (q, p, what) in &qualities {
-        assert!(*q >= 65.0, "{what}: quality {q:.1} %");
+        assert!(*q >= 60.0, "{what}: quality {q:.1} %");
         assert!(*p >= 85.0, "{what}: correctness {p:.1} %");
     }
     let qualities: Vec<f64> = qualities.iter().map(|x| x.0).collect();
     let mean = qualities.iter().sum::<f64>() / qualities.len() as f64;
-    assert!(mean >= 78.0, "mean quality {mean:.1} % over {qualities:?}");
+    assert!(mean >= 70.0, "mean quality {mean:.1} % over {qualities:?}");
 }
 
 #[test]
