@@ -82,6 +82,10 @@ def street(out, seed):
         for s in j["sides"]:
             e["side_" + s["side"]] = combine([s["total"]])
         e["unattributed_m"] = j["extracted_unattributed_m"]
+        sv = j.get("survey") or {}
+        e["class_checked_m"] = sv.get("class_checked_m") or 0.0
+        e["class_right_m"] = sv.get("class_right_m") or 0.0
+        e["class_pct"] = 100 * e["class_right_m"] / e["class_checked_m"] if e["class_checked_m"] > 0 else None
         r[method] = e
         w = re.search(r"wall_ms (\d+)", (d / f"{method}.extract.txt").read_text())
         r[method + "_ms"] = int(w.group(1)) if w else None
@@ -137,6 +141,8 @@ def main():
     med = lambda xs: percentile([x for x in xs if x is not None], 0.5)
     cat_q = lambda m, c: [s[m][c]["quality"] if s[m][c] else None for s in (bend if m == "bend" else qiu)]
     close_q = [s["bend"]["total"]["quality"] for s in bend if s["spacing_m"] is not None and s["spacing_m"] <= 0.15]
+    checked = sum(s["bend"]["class_checked_m"] for s in bend)
+    class_all = 100 * sum(s["bend"]["class_right_m"] for s in bend) / checked if checked > 0 else None
     targets = [
         ("bend median total quality", med([s["bend"]["total"]["quality"] for s in bend]), ">= 96"),
         ("bend 10th percentile total quality", percentile([s["bend"]["total"]["quality"] for s in bend], 0.1), ">= 93"),
@@ -144,6 +150,7 @@ def main():
         ("bend median curb-cut quality", med(cat_q("bend", "curb_cut")), ">= 90"),
         ("bend median intersection quality", med(cat_q("bend", "intersection")), ">= 85"),
         ("bend largest RMS [mm]", max(s["bend"]["rms_mm"] or 0.0 for s in bend) if bend else None, "<= 15"),
+        ("bend extracted length in the right class, all streets [%]", class_all, ">= 95"),
         ("qiu median completeness", med([s["qiu"]["total"]["completeness"] for s in qiu]), ">= 92"),
         ("qiu median correctness", med([s["qiu"]["total"]["correctness"] for s in qiu]), ">= 97"),
         ("qiu median far-side completeness", med([s["qiu"].get("side_" + (s["far"] or ""), {}).get("completeness") for s in qiu]), ">= 88"),
@@ -170,6 +177,7 @@ def main():
     p(dist_row("completeness", [s["bend"]["total"]["completeness"] for s in bend], n_all))
     p(dist_row("correctness", [s["bend"]["total"]["correctness"] for s in bend], n_all))
     p(dist_row("RMS [mm]", [s["bend"]["rms_mm"] for s in bend], n_all))
+    p(dist_row("length in the right class", [s["bend"]["class_pct"] for s in bend], n_all))
     for c in CATS:
         p(dist_row(f"{c} completeness", [s["bend"][c]["completeness"] if s["bend"][c] else None for s in bend], n_all))
     close = [s for s in bend if s["spacing_m"] is not None and s["spacing_m"] <= 0.15]

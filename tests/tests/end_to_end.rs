@@ -7,7 +7,7 @@
 //! Run in release (`cargo test --release`): the larger scene has millions of points.
 
 use curbtrace_host_sim::config::Config;
-use curbtrace_host_sim::eval::{evaluate, EvalParams, EvalReport};
+use curbtrace_host_sim::eval::{evaluate, survey, EvalParams, EvalReport};
 use curbtrace_host_sim::model::{read_geojson, Category};
 use curbtrace_host_sim::pipeline::{ExtractOptions, Progress};
 use curbtrace_host_sim::simulate;
@@ -34,6 +34,16 @@ fn simulate_extract_eval(scene: &str, seed: u64, dir: &Path) -> EvalReport {
         assert!(e.points.len() >= 2);
     }
     let (reference, _) = read_geojson(&dir.join("reference.geojson")).expect("reference");
+    // The class of every stretch (curb, curb_cut, intersection, bus_bay): at least 95 % of
+    // the extracted length that lies on a reference line has the reference's category.
+    let s = survey(&reference, &result.edges, &EvalParams::default()).expect("survey runs");
+    let right = 100.0 * s.class_right_m / s.class_checked_m.max(1e-9);
+    assert!(
+        s.class_checked_m > 0.0 && right >= 95.0,
+        "{scene}: {right:.1} % of {:.1} m in the right class; confusion {:?}",
+        s.class_checked_m,
+        s.confusion
+    );
     evaluate(&reference, &result.edges, &EvalParams::default()).expect("evaluation runs")
 }
 

@@ -10,17 +10,37 @@ use crate::model::{Category, CurbDetail, EdgeLine, Side};
 /// Angle between the edge and the route above which a vertex is on an intersection
 /// (corner arc or side street), degrees.
 pub const TURN_DEG: f64 = 30.0;
+/// Angle above which a vertex next to an intersection run still belongs to it: a corner
+/// arc starts tangent to the curb, so its first part turns less than [`TURN_DEG`] (an arc
+/// of radius R turns 30° over 0.52·R). Well above the angle a straight curb shows against
+/// the route (a few degrees: the vehicle's wander, the tangent's noise).
+pub const TURN_GROW_DEG: f64 = 8.0;
 /// How much wider than usual the road is at a bus bay or setback, metres.
 pub const BAY_MIN_M: f64 = 0.5;
 /// How far a vertex with no curb on the other side stands out from its side's usual
 /// offset to be on a bus bay, metres: the bay's threshold plus a lane's slack for the
 /// vehicle's wander.
 pub const BAY_ALONE_M: f64 = 1.2;
+/// Reach along the route within which a bus bay's curb must come back to its side's line
+/// at both ends, metres: a bay is a recess, while a road that widens for good is plain curb.
+pub const BAY_RETURN_M: f64 = 10.0;
 /// Reach along the route within which the other side's curb counts as beside a vertex,
 /// metres.
 pub const PAIR_M: f64 = 1.0;
+/// Distance within which the end of one edge continues another edge's end, metres (the
+/// tracker ends a track where a corner arc begins and starts another on the arc).
+pub const END_JOIN_M: f64 = 0.5;
 /// Highest curb at a curb cut (a lowered curb's lip, a ramp), metres.
 pub const CUT_MAX_M: f64 = 0.05;
+/// Where the full height beside a curb cut is taken: the curb vertices this far beyond the
+/// end of its low run, metres (past the longest transition, within the next driveway's
+/// reach).
+pub const CUT_FULL_M: (f64, f64) = (2.0, 5.0);
+/// A vertex next to a curb cut belongs to its transition while it stays this much below the
+/// full height beside it (a share of that height, at least [`CUT_SLACK_MIN_M`]).
+pub const CUT_SLACK: f64 = 0.05;
+/// The least slack below the full height, metres: the height's noise along a curb.
+pub const CUT_SLACK_MIN_M: f64 = 0.01;
 /// Shortest low run that is a flush edge rather than a curb cut, metres (curb cuts for
 /// driveways and crossings are up to about 15 m with their transitions).
 pub const FLUSH_MIN_M: f64 = 20.0;
@@ -39,8 +59,8 @@ const LINE_QUANTILE: f64 = 0.2;
 /// there minus the usual width; elsewhere by its offset minus its side's usual offset,
 /// against a threshold that allows for the wander.
 pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
-    // Per vertex: (turned, offset from the route, station).
-    let geo: Vec<Vec<(bool, f64, f64)>> = edges
+    // Per vertex: (angle to the route in degrees, offset from the route, station).
+    let geo: Vec<Vec<(f64, f64, f64)>> = edges
         .iter()
         .map(|e| {
             (0..e.points.len())
@@ -50,12 +70,12 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
                         (Some(t), Some((q, f))) => {
                             let c = (t[0] * f[0] + t[1] * f[1]).abs().min(1.0);
                             (
-                                c.acos().to_degrees() > TURN_DEG,
+                                c.acos().to_degrees(),
                                 (p[0] - q[0]).hypot(p[1] - q[1]),
                                 route.station_near(p[0], p[1]).unwrap_or(f64::NAN),
                             )
                         }
-                        _ => (false, f64::NAN, f64::NAN),
+                        _ => (0.0, f64::NAN, f64::NAN),
                     }
                 })
                 .collect()
@@ -67,7 +87,7 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
         let s = usize::from(e.side == Side::Right);
         along[s].extend(
             g.iter()
-                .filter(|g| !g.0 && g.1.is_finite() && g.2.is_finite())
+                .filter(|g| g.0 <= TURN_DEG && g.1.is_finite() && g.2.is_finite())
                 .map(|g| (g.2, g.1)),
         );
     }
@@ -105,7 +125,7 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
         d.class = g
             .iter()
             .zip(&d.height_m)
-            .map(|(&(turned, off, station), &h)| {
+            .map(|(&(angle, off, station), &h)| {
                 let stand_out = |o: f64, s: usize| side_line[s].map_or(0.0, |l| o - l);
                 let out_by = match (beside(side, station), width_line) {
                     // The wider road is this side's bay when this side's curb stands out
@@ -116,7 +136,7 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
                     (Some(_), Some(_)) => f64::NEG_INFINITY,
                     _ => side_line[side].map_or(f64::NEG_INFINITY, |l| off - l - BAY_ALONE_M),
                 };
-                if turned {
+                if angle > TURN_DEG {
                     Category::Intersection
                 } else if out_by > 0.0 {
                     Category::BusBay
@@ -127,6 +147,167 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
                 }
             })
             .collect();
+        let angle: Vec<f64> = g.iter().map(|g| g.0).collect();
+        grow_intersections(&angle, &mut d.class);
+    }
+    // An edge that ends where another edge's intersection run ends continues the corner:
+    // its end grows into the intersection too.
+    let corner_ends: Vec<(Side, [f64; 3])> = edges
+        .iter()
+        .filter_map(|e| e.detail.as_ref().map(|d| (e, d)))
+        .flat_map(|(e, d)| {
+            let last = e.points.len().min(d.class.len()).saturating_sub(1);
+            [0, last]
+                .into_iter()
+                .filter(|&k| d.class.get(k) == Some(&Category::Intersection))
+                .map(|k| (e.side, e.points[k]))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    for (e, g) in edges.iter_mut().zip(&geo) {
+        let side = e.side;
+        let m = e.points.len();
+        let near_corner = |p: [f64; 3]| {
+            corner_ends
+                .iter()
+                .any(|(s, q)| *s == side && (p[0] - q[0]).hypot(p[1] - q[1]) <= END_JOIN_M)
+        };
+        let ends: Vec<usize> = [0, m.saturating_sub(1)]
+            .into_iter()
+            .filter(|&k| g.get(k).is_some_and(|g| g.0 > TURN_GROW_DEG) && near_corner(e.points[k]))
+            .collect();
+        let Some(d) = e.detail.as_mut() else { continue };
+        if ends.is_empty() || d.class.len() != m {
+            continue;
+        }
+        for k in ends {
+            d.class[k] = Category::Intersection;
+        }
+        let angle: Vec<f64> = g.iter().map(|g| g.0).collect();
+        grow_intersections(&angle, &mut d.class);
+    }
+    // A bus bay is a recess: its side's curb is back on its usual line within BAY_RETURN_M
+    // before and after it (clearly back: within half the thresholds that make a bay). Other
+    // wide runs (a road that widens for good) are curb.
+    let on_line = |side: usize, off: f64, station: f64| match (beside(side, station), width_line) {
+        (Some(o), Some(w)) => off + o - w < 0.5 * BAY_MIN_M,
+        _ => side_line[side].is_none_or(|l| off - l < 0.5 * BAY_ALONE_M),
+    };
+    let mut line: [Vec<(f64, bool)>; 2] = [Vec::new(), Vec::new()];
+    for (e, g) in edges.iter().zip(&geo) {
+        let Some(d) = e.detail.as_ref() else { continue };
+        let side = usize::from(e.side == Side::Right);
+        line[side].extend(
+            g.iter()
+                .zip(&d.class)
+                .filter(|(g, c)| {
+                    g.1.is_finite() && g.2.is_finite() && **c != Category::Intersection
+                })
+                .map(|(g, _)| (g.2, !on_line(side, g.1, g.2))),
+        );
+    }
+    for (e, g) in edges.iter_mut().zip(&geo) {
+        let side = usize::from(e.side == Side::Right);
+        let Some(d) = e.detail.as_mut() else { continue };
+        let m = d.class.len().min(g.len()).min(d.height_m.len());
+        let mut k = 0;
+        while k < m {
+            if d.class[k] != Category::BusBay {
+                k += 1;
+                continue;
+            }
+            let a = k;
+            while k < m && d.class[k] == Category::BusBay {
+                k += 1;
+            }
+            let (s0, s1) = g[a..k]
+                .iter()
+                .map(|g| g.2)
+                .filter(|s| s.is_finite())
+                .fold((f64::MAX, f64::MIN), |(lo, hi), s| (lo.min(s), hi.max(s)));
+            let back = |lo: f64, hi: f64| {
+                line[side]
+                    .iter()
+                    .any(|&(s, bay)| !bay && s >= lo && s <= hi)
+            };
+            if !(back(s0 - BAY_RETURN_M, s0) && back(s1, s1 + BAY_RETURN_M)) {
+                for j in a..k {
+                    d.class[j] = if d.height_m[j] < CUT_MAX_M {
+                        Category::CurbCut
+                    } else {
+                        Category::Curb
+                    };
+                }
+            }
+        }
+    }
+}
+
+/// Extends every intersection run over the vertices beside it that still turn more than
+/// [`TURN_GROW_DEG`] from the route (the start of a corner arc).
+fn grow_intersections(angle: &[f64], class: &mut [Category]) {
+    let m = angle.len().min(class.len());
+    for k in 1..m {
+        if class[k - 1] == Category::Intersection && angle[k] > TURN_GROW_DEG {
+            class[k] = Category::Intersection;
+        }
+    }
+    for k in (0..m.saturating_sub(1)).rev() {
+        if class[k + 1] == Category::Intersection && angle[k] > TURN_GROW_DEG {
+            class[k] = Category::Intersection;
+        }
+    }
+}
+
+/// Extends every curb-cut run over its transitions (on the closed edge): the curb vertices
+/// beside it that stay more than the slack ([`CUT_SLACK`]) below the full height, the
+/// median height of the curb vertices [`CUT_FULL_M`] beyond the run's end.
+pub fn grow_cuts(pts: &[[f64; 3]], d: &mut CurbDetail) {
+    let s = arc(pts);
+    let m = d.class.len().min(pts.len()).min(d.height_m.len());
+    let runs: Vec<(usize, usize)> = {
+        let mut v = Vec::new();
+        let mut k = 0;
+        while k < m {
+            if d.class[k] != Category::CurbCut {
+                k += 1;
+                continue;
+            }
+            let a = k;
+            while k < m && d.class[k] == Category::CurbCut {
+                k += 1;
+            }
+            v.push((a, k - 1));
+        }
+        v
+    };
+    for (a, b) in runs {
+        for forward in [true, false] {
+            let end = if forward { s[b] } else { s[a] };
+            let beyond = |k: usize| {
+                let dist = if forward { s[k] - end } else { end - s[k] };
+                dist >= CUT_FULL_M.0 && dist <= CUT_FULL_M.1
+            };
+            let mut full: Vec<f64> = (0..m)
+                .filter(|&k| beyond(k) && d.class[k] == Category::Curb)
+                .map(|k| d.height_m[k])
+                .collect();
+            let Some(full) = super::median(&mut full) else {
+                continue;
+            };
+            let below = full - (CUT_SLACK * full).max(CUT_SLACK_MIN_M);
+            let steps: Box<dyn Iterator<Item = usize>> = if forward {
+                Box::new(b + 1..m)
+            } else {
+                Box::new((0..a).rev())
+            };
+            for k in steps {
+                if d.class[k] != Category::Curb || d.height_m[k] >= below {
+                    break;
+                }
+                d.class[k] = Category::CurbCut;
+            }
+        }
     }
 }
 
@@ -239,6 +420,73 @@ mod tests {
             runs,
             vec![(0, 60, Category::Curb), (60, 100, Category::CurbCut)]
         );
+    }
+
+    #[test]
+    fn a_curb_cut_takes_its_transitions_up_to_near_the_full_height() {
+        // 0.15 m curb; lowered to 0.02 m over vertices 30..=60 (0.1 m apart) with 1 m
+        // linear transitions either side.
+        let p = pts(101, 0.1);
+        let mut d = CurbDetail::measured(&p);
+        for (k, h) in d.height_m.iter_mut().enumerate() {
+            let x = (k as f64 - 45.0).abs() - 15.0; // vertices beyond the lowered part
+            let f = (1.0 - x / 10.0).clamp(0.0, 1.0);
+            *h = 0.15 - (0.15 - 0.02) * f;
+        }
+        d.class = d
+            .height_m
+            .iter()
+            .map(|&h| {
+                if h < CUT_MAX_M {
+                    Category::CurbCut
+                } else {
+                    Category::Curb
+                }
+            })
+            .collect();
+        assert_eq!(d.class[26], Category::Curb, "0.059 m before growing");
+        grow_cuts(&p, &mut d);
+        // The transitions' vertices below 0.15 − max(5 % of 0.15, 1 cm) = 0.14 m join the
+        // cut: 21..=69 (0.137 m at 21 and 69, 0.15 m at 20 and 70).
+        for k in 0..=100 {
+            let want = if d.height_m[k] < 0.14 {
+                Category::CurbCut
+            } else {
+                Category::Curb
+            };
+            assert_eq!(d.class[k], want, "vertex {k} at {:.4} m", d.height_m[k]);
+        }
+        assert_eq!(d.class[20], Category::Curb);
+        assert_eq!(d.class[21], Category::CurbCut);
+    }
+
+    #[test]
+    fn an_intersection_run_takes_the_start_of_its_corner_arc() {
+        // The angle to the route rises 0°, 2°, … 60°: 30° and above is an intersection, and
+        // the vertices beside the run down to 8° join it; a lone 10° wobble elsewhere does
+        // not.
+        let mut angle: Vec<f64> = (0..31).map(|k| 2.0 * k as f64).collect();
+        angle.extend([0.0, 10.0, 0.0]);
+        let mut class: Vec<Category> = angle
+            .iter()
+            .map(|&a| {
+                if a > TURN_DEG {
+                    Category::Intersection
+                } else {
+                    Category::Curb
+                }
+            })
+            .collect();
+        grow_intersections(&angle, &mut class);
+        for (k, &a) in angle.iter().enumerate().take(31) {
+            let want = if a > TURN_GROW_DEG {
+                Category::Intersection
+            } else {
+                Category::Curb
+            };
+            assert_eq!(class[k], want, "vertex {k} at {a}°");
+        }
+        assert_eq!(class[32], Category::Curb);
     }
 
     #[test]

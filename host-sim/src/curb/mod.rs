@@ -230,6 +230,7 @@ pub fn finish(edges: Vec<EdgeLine>) -> Vec<EdgeLine> {
         if d.class.len() != e.points.len() {
             d.class = vec![e.category.unwrap_or(Category::Curb); e.points.len()];
         }
+        class::grow_cuts(&e.points, d);
         class::flush_runs(&e.points, d);
         let class = class::smoothed_runs(&e.points, &d.class, class::MIN_RUN_M);
         let measured = d.measured.clone();
