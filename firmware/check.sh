@@ -14,7 +14,8 @@
 #
 # Needs Debian's rustc-web, cargo-web, rust-web-src, lld-19, qemu-system-arm (scripts/test.sh
 # installs them), gcc, binutils and rustup's stable cargo for the host side.
-# Environment: FIRMWARE_TARGET_DIR (default firmware/target), CARGO_TARGET_DIR (host build,
+# Environment: CURBTRACE_BIN (a built `curbtrace` to use instead of building one),
+# FIRMWARE_TARGET_DIR (default firmware/target), CARGO_TARGET_DIR (host build,
 # default target/), QEMU_TIMEOUT seconds per QEMU run (default 600), CHECK_KEEP=1 keeps the
 # work directory.
 set -euo pipefail
@@ -55,7 +56,9 @@ HC="$HOST_TARGET/firmware-host-check/release"
 # The host program's `curbtrace kernel` is the reference; until it exists, fw-kernel (the
 # firmware's own loop compiled for the host) is.
 CURBTRACE=""
-if cargo build --release --quiet -p curbtrace-host-sim --bin curbtrace >&2 &&
+if [ -n "${CURBTRACE_BIN:-}" ]; then
+  CURBTRACE="$CURBTRACE_BIN"
+elif cargo build --release --quiet -p curbtrace-host-sim --bin curbtrace >&2 &&
   "$HOST_TARGET/release/curbtrace" kernel --help > /dev/null 2>&1; then
   CURBTRACE="$HOST_TARGET/release/curbtrace"
 fi

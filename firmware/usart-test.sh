@@ -13,7 +13,8 @@
 # byte-identical and the receive side lost no byte (queue full, overrun or line error).
 # Progress goes to stderr.
 #
-# Needs what firmware/check.sh needs. Environment: FIRMWARE_TARGET_DIR (default
+# Needs what firmware/check.sh needs. Environment: CURBTRACE_BIN (a built `curbtrace` to
+# use instead of building one), FIRMWARE_TARGET_DIR (default
 # firmware/target), CARGO_TARGET_DIR (host build, default target/), QEMU_TIMEOUT seconds
 # (default 300), CHECK_KEEP=1 keeps the work directory.
 set -euo pipefail
@@ -53,8 +54,12 @@ if [ "$MAX_BYTES" != all ]; then
   "$HC/fw-head" "$STREAM" "$WORK/stream.bin" "$MAX_BYTES" >&2
   STREAM="$WORK/stream.bin"
 fi
-cargo build --release --quiet -p curbtrace-host-sim --bin curbtrace >&2
-"$HOST_TARGET/release/curbtrace" kernel "$STREAM" -o "$WORK/out-host.bin" >&2
+CURBTRACE=${CURBTRACE_BIN:-}
+if [ -z "$CURBTRACE" ]; then
+  cargo build --release --quiet -p curbtrace-host-sim --bin curbtrace >&2
+  CURBTRACE="$HOST_TARGET/release/curbtrace"
+fi
+"$CURBTRACE" kernel "$STREAM" -o "$WORK/out-host.bin" >&2
 
 # QEMU's serial chardevs map in order onto USART1, USART2, USART3, UART4, UART5, USART6.
 SOCK="$WORK/usart3.sock"

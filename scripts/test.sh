@@ -25,6 +25,10 @@ if [ ${#need_apt[@]} -gt 0 ]; then
 fi
 
 # --- host -------------------------------------------------------------------------------
+# The host's release builds here go without debug info (the release profile keeps it for
+# profiling): less to compile and link. The firmware keeps its own profile.
+export CARGO_PROFILE_RELEASE_DEBUG=false
+
 step "cargo fmt --check"
 cargo fmt --all --check
 
@@ -36,6 +40,8 @@ cargo test --workspace --release
 
 step "cargo test curbtrace-core with micromath (its rho against libm's, differential test)"
 cargo test -p curbtrace-core --release --features micromath
+
+unset CARGO_PROFILE_RELEASE_DEBUG
 
 # --- no_std core for the Cortex-M4F -----------------------------------------------------
 for feat in libm micromath; do
@@ -60,13 +66,16 @@ cargo test --manifest-path firmware/host-check/Cargo.toml --target-dir "$HC_TARG
 
 step "firmware: a tiny simulated stream through QEMU and the host core, compared (firmware/check.sh)"
 FW_WORK=$(mktemp -d)
-cargo run --release --quiet -p curbtrace-host-sim -- simulate --scene tiny -o "$FW_WORK/sim"
-cargo run --release --quiet -p curbtrace-host-sim -- replay "$FW_WORK/sim/points.laz" \
+# The binary the workspace's tests built (`cargo build -p` alone would build it again with
+# another feature set).
+CURBTRACE="${CARGO_TARGET_DIR:-$ROOT/target}/release/curbtrace"
+"$CURBTRACE" simulate --scene tiny -o "$FW_WORK/sim" >/dev/null
+"$CURBTRACE" replay "$FW_WORK/sim/points.laz" \
   --trajectory "$FW_WORK/sim/trajectory.csv" -o "$FW_WORK/tiny.bin"
-QEMU_TIMEOUT=300 firmware/check.sh "$FW_WORK/tiny.bin"
+CURBTRACE_BIN="$CURBTRACE" QEMU_TIMEOUT=300 firmware/check.sh "$FW_WORK/tiny.bin"
 
 step "firmware: the USART links under QEMU: the tiny stream's first 1 MB in on USART3, the packets out on USART6, compared with the host core (firmware/usart-test.sh)"
-QEMU_TIMEOUT=240 timeout 300 firmware/usart-test.sh "$FW_WORK/tiny.bin" 1000000 < /dev/null
+CURBTRACE_BIN="$CURBTRACE" QEMU_TIMEOUT=240 timeout 300 firmware/usart-test.sh "$FW_WORK/tiny.bin" 1000000 < /dev/null
 rm -rf "$FW_WORK"
 
 step "firmware: the board build (Feather STM32F405; USART and SPI-slave inputs; built, cannot run here)"
@@ -89,6 +98,8 @@ for t in overflow hardfault panic; do
 done
 
 # --- the Python package (python/, docs/python.md) ----------------------------------------
+# The same host profile as the workspace's tests, whose dependencies maturin reuses.
+export CARGO_PROFILE_RELEASE_DEBUG=false
 step "python: cargo fmt --check and clippy (-D warnings) on python/ (its own workspace), with the workspace's target directory"
 cargo fmt --check --manifest-path python/Cargo.toml
 CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$ROOT/target}" \
