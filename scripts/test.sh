@@ -74,8 +74,11 @@ CURBTRACE="${CARGO_TARGET_DIR:-$ROOT/target}/release/curbtrace"
   --trajectory "$FW_WORK/sim/trajectory.csv" -o "$FW_WORK/tiny.bin"
 CURBTRACE_BIN="$CURBTRACE" QEMU_TIMEOUT=300 firmware/check.sh "$FW_WORK/tiny.bin"
 
-step "firmware: the USART links under QEMU: the tiny stream's first 1 MB in on USART3, the packets out on USART6, compared with the host core (firmware/usart-test.sh)"
-CURBTRACE_BIN="$CURBTRACE" QEMU_TIMEOUT=240 timeout 300 firmware/usart-test.sh "$FW_WORK/tiny.bin" 1000000 < /dev/null
+step "firmware: the USART links under QEMU: the tiny stream's first 500 kB in on USART3 at 115 200 baud, the packets out on USART6, compared with the host core (firmware/usart-test.sh)"
+# Paced as a 115 200-baud line (11 520 bytes/s, 8N1): unpaced, QEMU's USART model hands the
+# firmware bytes as fast as it reads them, a rate no wire has, and the receive queue
+# overflows whenever the host machine slows QEMU's processing more than its delivery.
+CURBTRACE_BIN="$CURBTRACE" QEMU_TIMEOUT=240 timeout 300 firmware/usart-test.sh "$FW_WORK/tiny.bin" 500000 11520 < /dev/null
 rm -rf "$FW_WORK"
 
 step "firmware: the board build (Feather STM32F405; USART and SPI-slave inputs; built, cannot run here)"
