@@ -210,16 +210,8 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
         let side = usize::from(e.side == Side::Right);
         let Some(d) = e.detail.as_mut() else { continue };
         let m = d.class.len().min(g.len()).min(d.height_m.len());
-        let mut k = 0;
-        while k < m {
-            if d.class[k] != Category::BusBay {
-                k += 1;
-                continue;
-            }
-            let a = k;
-            while k < m && d.class[k] == Category::BusBay {
-                k += 1;
-            }
+        for run in runs_of(&d.class, m, Category::BusBay) {
+            let (a, k) = (run.start, run.end);
             let (s0, s1) = g[a..k]
                 .iter()
                 .map(|g| g.2)
@@ -265,23 +257,8 @@ fn grow_intersections(angle: &[f64], class: &mut [Category]) {
 pub fn grow_cuts(pts: &[[f64; 3]], d: &mut CurbDetail) {
     let s = arc(pts);
     let m = d.class.len().min(pts.len()).min(d.height_m.len());
-    let runs: Vec<(usize, usize)> = {
-        let mut v = Vec::new();
-        let mut k = 0;
-        while k < m {
-            if d.class[k] != Category::CurbCut {
-                k += 1;
-                continue;
-            }
-            let a = k;
-            while k < m && d.class[k] == Category::CurbCut {
-                k += 1;
-            }
-            v.push((a, k - 1));
-        }
-        v
-    };
-    for (a, b) in runs {
+    for run in runs_of(&d.class, m, Category::CurbCut) {
+        let (a, b) = (run.start, run.end - 1);
         for forward in [true, false] {
             let end = if forward { s[b] } else { s[a] };
             let beyond = |k: usize| {
@@ -311,6 +288,25 @@ pub fn grow_cuts(pts: &[[f64; 3]], d: &mut CurbDetail) {
     }
 }
 
+/// The runs `a..b` (end exclusive) of consecutive vertices of class `cat` among the first
+/// `m` of `class`.
+fn runs_of(class: &[Category], m: usize, cat: Category) -> Vec<std::ops::Range<usize>> {
+    let mut v = Vec::new();
+    let mut k = 0;
+    while k < m {
+        if class[k] != cat {
+            k += 1;
+            continue;
+        }
+        let a = k;
+        while k < m && class[k] == cat {
+            k += 1;
+        }
+        v.push(a..k);
+    }
+    v
+}
+
 /// Arc length at each vertex.
 fn arc(pts: &[[f64; 3]]) -> Vec<f64> {
     let mut s = vec![0.0; pts.len()];
@@ -325,18 +321,9 @@ fn arc(pts: &[[f64; 3]]) -> Vec<f64> {
 pub fn flush_runs(pts: &[[f64; 3]], d: &mut CurbDetail) {
     let s = arc(pts);
     let m = d.class.len().min(pts.len());
-    let mut k = 0;
-    while k < m {
-        if d.class[k] != Category::CurbCut {
-            k += 1;
-            continue;
-        }
-        let a = k;
-        while k < m && d.class[k] == Category::CurbCut {
-            k += 1;
-        }
-        if s[k - 1] - s[a] >= FLUSH_MIN_M {
-            d.class[a..k].fill(Category::Flush);
+    for run in runs_of(&d.class, m, Category::CurbCut) {
+        if s[run.end - 1] - s[run.start] >= FLUSH_MIN_M {
+            d.class[run].fill(Category::Flush);
         }
     }
 }
