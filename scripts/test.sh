@@ -32,8 +32,10 @@ export CARGO_PROFILE_RELEASE_DEBUG=false
 step "cargo fmt --check"
 cargo fmt --all --check
 
+# Clippy in the release profile: the build scripts and proc-macros it compiles (SQLite's C
+# build among them) are the ones the release tests below reuse.
 step "cargo clippy (workspace, all targets, -D warnings)"
-cargo clippy --workspace --all-targets -- -D warnings
+cargo clippy --release --workspace --all-targets -- -D warnings
 
 step "cargo test (workspace, release: the end-to-end tests run real scenes)"
 cargo test --workspace --release
@@ -44,12 +46,9 @@ cargo test -p curbtrace-core --release --features micromath
 unset CARGO_PROFILE_RELEASE_DEBUG
 
 # --- no_std core for the Cortex-M4F -----------------------------------------------------
-for feat in libm micromath; do
-  step "curbtrace-core for thumbv7em-none-eabihf (Debian toolchain, feature $feat)"
-  RUSTC_BOOTSTRAP=1 RUSTC=/usr/bin/rustc CARGO_TARGET_DIR="$ROOT/target/thumb" \
-    /usr/bin/cargo build -p curbtrace-core --release --target thumbv7em-none-eabihf \
-    -Zbuild-std=core --no-default-features --features "$feat"
-done
+# The firmware builds of firmware/check.sh below compile curbtrace-core for
+# thumbv7em-none-eabihf with no default features and each maths feature (libm, micromath):
+# that is the no_std build of the core, so it is not built a second time on its own here.
 
 # --- firmware: the core on the STM32F405 under QEMU (firmware/check.sh) ----------------------
 step "firmware: cargo fmt --check, clippy on the host target for the QEMU, USART and board builds (-D warnings), host-check tests"
@@ -106,7 +105,7 @@ export CARGO_PROFILE_RELEASE_DEBUG=false
 step "python: cargo fmt --check and clippy (-D warnings) on python/ (its own workspace), with the workspace's target directory"
 cargo fmt --check --manifest-path python/Cargo.toml
 CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$ROOT/target}" \
-  cargo clippy --manifest-path python/Cargo.toml --all-targets -- -D warnings
+  cargo clippy --release --manifest-path python/Cargo.toml --all-targets -- -D warnings
 
 step "python: the curbtrace wheel built with maturin into a fresh venv, installed with its pinned test dependencies from PyPI, pytest"
 # The machine's CPython on PATH (3.11 with pip) has venv and ensurepip; Debian's

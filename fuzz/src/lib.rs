@@ -3,6 +3,9 @@
 //! asserted after every step, not just "no panic".
 #![forbid(unsafe_code)]
 
+#[cfg(feature = "host")]
+pub mod host_inputs;
+
 use curbtrace_core::kernel::{Kernel, KernelParams, PointStatus, ScanlineOutput};
 use curbtrace_core::scanline::{Ingest, IngestCounters, IngestEvent};
 use curbtrace_core::wire::{crc, HEADER_LEN, MAX_PACKET_LEN, MIN_PACKET_LEN, SYNC};
