@@ -2,14 +2,17 @@
 //! projection → wire bytes → core → seeding/tracking/post-filters), score them against the
 //! simulator's ground truth (docs/spec.md §5), and assert the accuracy targets
 //! (completeness ≥ 95 %, correctness ≥ 95 %, quality ≥ 90 %, RMS ≤ 20 mm at a 50 mm buffer)
-//! with the one set of default parameters.
+//! with the one set of default parameters. On each scene the streaming extract (the product
+//! path) is also held against the whole-file run within the campaign issue's ε: the matched
+//! parts of the edges within 1 cm (Hausdorff, both ways) and the total quality within
+//! 0.2 pp.
 //!
 //! Run in release (`cargo test --release`): the larger scene has millions of points.
 
 use curbtrace_host_sim::config::Config;
-use curbtrace_host_sim::eval::{evaluate, survey, EvalParams, EvalReport};
+use curbtrace_host_sim::eval::{agreement, evaluate, survey, EvalParams, EvalReport};
 use curbtrace_host_sim::model::{read_geojson, Category};
-use curbtrace_host_sim::pipeline::{ExtractOptions, Progress};
+use curbtrace_host_sim::pipeline::{self, ExtractOptions, Progress};
 use curbtrace_host_sim::simulate;
 use curbtrace_host_sim::stream::{self, WindowParams};
 use std::path::Path;
@@ -34,6 +37,26 @@ fn simulate_extract_eval(scene: &str, seed: u64, dir: &Path) -> EvalReport {
         assert!(e.points.len() >= 2);
     }
     let (reference, _) = read_geojson(&dir.join("reference.geojson")).expect("reference");
+    let report = evaluate(&reference, &result.edges, &EvalParams::default()).expect("evaluation");
+    // The same edges as the whole-file run, within ε.
+    let whole = pipeline::extract_file(
+        &dir.join("points.laz"),
+        &dir.join("trajectory.csv"),
+        &Config::default(),
+    )
+    .expect("whole-file extraction runs");
+    let whole_q = evaluate(&reference, &whole.edges, &EvalParams::default())
+        .expect("evaluation")
+        .total
+        .quality_pct
+        .expect("quality");
+    let stream_q = report.total.quality_pct.expect("quality");
+    assert!(
+        (whole_q - stream_q).abs() <= 0.2,
+        "{scene}: quality {stream_q:.3} % streamed, {whole_q:.3} % whole"
+    );
+    let g = agreement(&whole.edges, &result.edges, 0.5);
+    assert!(g.matched_hausdorff_m <= 0.01, "{scene}: {g:?}");
     // The class of every stretch (curb, curb_cut, intersection, bus_bay): at least 95 % of
     // the extracted length that lies on a reference line has the reference's category.
     let s = survey(&reference, &result.edges, &EvalParams::default()).expect("survey runs");
@@ -44,7 +67,7 @@ fn simulate_extract_eval(scene: &str, seed: u64, dir: &Path) -> EvalReport {
         s.class_checked_m,
         s.confusion
     );
-    evaluate(&reference, &result.edges, &EvalParams::default()).expect("evaluation runs")
+    report
 }
 
 fn assert_targets(scene: &str, r: &EvalReport) {
@@ -81,6 +104,13 @@ fn curvy_meets_the_accuracy_targets() {
     let dir = tempfile::tempdir().unwrap();
     let r = simulate_extract_eval("curvy", 1, dir.path());
     assert_targets("curvy", &r);
+}
+
+#[test]
+fn kawasaki_meets_the_accuracy_targets() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = simulate_extract_eval("kawasaki", 1, dir.path());
+    assert_targets("kawasaki", &r);
 }
 
 /// The larger scene with intersections: the totals, and each side's intersection corners
