@@ -137,7 +137,7 @@ pub fn extract(
     let mut times = pass.times;
     times.total_s = start.elapsed().as_secs_f64();
     times.cpu.total_s = process_cpu_s() - cpu0;
-    times.cpu.peak_rss = [peak_rss_bytes(); 3];
+    times.cpu.peak_rss = [0, 0, peak_rss_bytes()];
     let selected = pass.points + pass.dropped.0 + pass.dropped.1;
     let summary = Summary {
         las: info.las_info(selected, selection, reordered),
