@@ -154,7 +154,8 @@ pub struct StageCpu {
     pub edges_s: f64,
     /// Everything.
     pub total_s: f64,
-    /// Peak resident memory at the end of reading, of the core, of the edges, bytes.
+    /// Peak resident memory at the end of reading, of the core, of the edges, bytes. A
+    /// stream, whose stages run together, sets only the last (the first two are 0).
     pub peak_rss: [u64; 3],
 }
 
@@ -263,6 +264,11 @@ impl Summary {
     fn peak_memory_text(&self) -> String {
         const PER_POINT_FROM: u64 = 1_000_000;
         let [m0, m1, m2] = self.times.cpu.peak_rss.map(|b| b as f64);
+        let mib = f64::from(1u32 << 20);
+        if m0 == 0.0 && m1 == 0.0 {
+            // A stream: one figure for the whole pass, which does not grow with the points.
+            return format!("{:.1} MiB (streamed: one window in memory)", m2 / mib);
+        }
         if self.points_read() >= PER_POINT_FROM {
             let per = self.points_read() as f64;
             format!(
@@ -272,7 +278,6 @@ impl Summary {
                 m2 / per
             )
         } else {
-            let mib = f64::from(1u32 << 20);
             format!(
                 "{:.1} MiB after reading, {:.1} MiB after the core, {:.1} MiB after the edges",
                 m0 / mib,

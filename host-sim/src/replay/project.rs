@@ -15,6 +15,9 @@ use crate::io::trajectory::{Pose, Trajectory};
 pub struct PoseCursor<'a> {
     samples: &'a [Pose],
     k: usize,
+    /// The last heading (radians) and its sine and cosine: a vehicle driving straight keeps
+    /// one heading over many points, and the same heading gives the same bits.
+    sin_cos: (u64, f64, f64),
 }
 
 impl<'a> PoseCursor<'a> {
@@ -23,6 +26,7 @@ impl<'a> PoseCursor<'a> {
         Self {
             samples: &traj.samples,
             k: 0,
+            sin_cos: (f64::NAN.to_bits(), f64::NAN, f64::NAN),
         }
     }
 
@@ -51,7 +55,11 @@ impl<'a> PoseCursor<'a> {
             dh += 360.0;
         }
         let h = (a.heading_deg + dh * w).to_radians();
-        let (sin_h, cos_h) = h.sin_cos();
+        if h.to_bits() != self.sin_cos.0 {
+            let (sin_h, cos_h) = h.sin_cos();
+            self.sin_cos = (h.to_bits(), sin_h, cos_h);
+        }
+        let (_, sin_h, cos_h) = self.sin_cos;
         Some((
             [
                 a.x + (b.x - a.x) * w,

@@ -335,6 +335,26 @@ fn run_chunk(
     Ok(out)
 }
 
+/// The pool that runs pipelines, built once per process: a stream calls
+/// [`run_kernel_with_rule`] once per batch, and a pool per call started and ended its
+/// threads every 2^15 points. A pool of our own, not rayon's global one: a pipeline holds a
+/// few MB of fixed buffers, more than rayon's default 2 MiB worker stacks take in a debug
+/// build.
+fn pipeline_pool() -> Result<&'static rayon::ThreadPool, ReplayError> {
+    static POOL: std::sync::OnceLock<Result<rayon::ThreadPool, String>> =
+        std::sync::OnceLock::new();
+    POOL.get_or_init(|| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(rayon::current_num_threads())
+            .stack_size(PIPELINE_STACK)
+            .thread_name(|i| format!("ct-core-{i}"))
+            .build()
+            .map_err(|e| e.to_string())
+    })
+    .as_ref()
+    .map_err(|e| ReplayError::Io(std::io::Error::other(e.clone())))
+}
+
 /// Runs every point of `cols` (all inside `traj`'s time range) through the core and
 /// collects its results per point. `progress` is called with points done so far.
 pub fn run_kernel(
@@ -377,13 +397,7 @@ pub fn run_kernel_with_rule(
         }
     }
     let done = std::sync::atomic::AtomicU64::new(0);
-    // A pool of our own: a pipeline holds a few MB of fixed buffers, more than rayon's
-    // default 2 MiB worker stacks take in a debug build.
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(rayon::current_num_threads())
-        .stack_size(PIPELINE_STACK)
-        .build()
-        .map_err(|e| ReplayError::Io(std::io::Error::other(e)))?;
+    let pool = pipeline_pool()?;
     let outs: Vec<Result<ChunkOut, ReplayError>> = pool.install(|| {
         parts
             .into_par_iter()

@@ -182,40 +182,95 @@ impl LasBatches {
             }
         }
         let sel = self.selection();
-        let Some(gps) = self.pd.gps_time() else {
+        let Some(gps_at) = self.gps_offset() else {
             return Err(LasError::NoGpsTime {
                 path: self.path.clone(),
                 format: self.format,
             });
         };
-        let iter = raw
-            .chunks_exact(rl)
-            .zip(self.pd.point_source_id())
-            .zip(self.pd.x().zip(self.pd.y()).zip(self.pd.z()))
-            .zip(
-                gps.zip(self.pd.intensity())
-                    .zip(self.pd.scan_angle_degrees()),
-            );
-        for (k, (((rec, psid), ((x, y), z)), ((t, i), sa))) in iter.enumerate() {
-            let ch = channel_of(rec);
-            let keep = match sel {
-                ScannerSelection::All => true,
-                ScannerSelection::Channel(c) => ch == c,
-                ScannerSelection::PointSourceId(id) => psid == id,
-            };
-            if !keep {
-                continue;
+        // Field offsets of the point record (LAS 1.4 R15 tables 7 and 12): X, Y, Z at 0, 4,
+        // 8, intensity at 12; scan angle, point source id and GPS time after the flags.
+        let (sa_at, psid_at) = if self.extended { (18, 20) } else { (16, 18) };
+        let tf = *self.pd.transforms();
+        let i32_at = |r: &[u8], k: usize| i32::from_le_bytes([r[k], r[k + 1], r[k + 2], r[k + 3]]);
+        let u16_at = |r: &[u8], k: usize| u16::from_le_bytes([r[k], r[k + 1]]);
+        let f64_at = |r: &[u8], k: usize| {
+            f64::from_le_bytes([
+                r[k],
+                r[k + 1],
+                r[k + 2],
+                r[k + 3],
+                r[k + 4],
+                r[k + 5],
+                r[k + 6],
+                r[k + 7],
+            ])
+        };
+        let extended = self.extended;
+        // As `las`'s `scan_angle_degrees`: 0.006° steps in formats 6–10, whole degrees before.
+        let angle = move |r: &[u8]| {
+            if extended {
+                f32::from(i16::from_le_bytes([r[sa_at], r[sa_at + 1]])) * 0.006
+            } else {
+                f32::from(r[sa_at] as i8)
             }
-            if !t.is_finite() {
-                return Err(LasError::BadTime {
-                    path: self.path.clone(),
-                    index: self.done + k as u64,
-                    t,
-                });
+        };
+        let from = out.len();
+        if sel == ScannerSelection::All {
+            // Every record kept: one tight pass per column.
+            let recs = || raw.chunks_exact(rl);
+            out.x.extend(recs().map(|r| tf.x.direct(i32_at(r, 0))));
+            out.y.extend(recs().map(|r| tf.y.direct(i32_at(r, 4))));
+            out.z.extend(recs().map(|r| tf.z.direct(i32_at(r, 8))));
+            out.t.extend(recs().map(|r| f64_at(r, gps_at)));
+            out.intensity.extend(recs().map(|r| u16_at(r, 12)));
+            out.scan_angle_deg.extend(recs().map(angle));
+            out.channel.extend(recs().map(channel_of));
+        } else {
+            for rec in raw.chunks_exact(rl) {
+                let keep = match sel {
+                    ScannerSelection::All => true,
+                    ScannerSelection::Channel(c) => channel_of(rec) == c,
+                    ScannerSelection::PointSourceId(id) => u16_at(rec, psid_at) == id,
+                };
+                if keep {
+                    out.push(
+                        tf.x.direct(i32_at(rec, 0)),
+                        tf.y.direct(i32_at(rec, 4)),
+                        tf.z.direct(i32_at(rec, 8)),
+                        f64_at(rec, gps_at),
+                        u16_at(rec, 12),
+                        angle(rec),
+                        channel_of(rec),
+                    );
+                }
             }
-            out.push(x, y, z, t, i, sa, ch);
+        }
+        if let Some(k) = out.t[from..].iter().position(|t| !t.is_finite()) {
+            // The index in the file: kept records before it, plus the skipped ones.
+            let t = out.t[from + k];
+            let index = raw
+                .chunks_exact(rl)
+                .position(|r| f64_at(r, gps_at).to_bits() == t.to_bits())
+                .unwrap_or(k) as u64;
+            return Err(LasError::BadTime {
+                path: self.path.clone(),
+                index: self.done + index,
+                t,
+            });
         }
         Ok(())
+    }
+
+    /// Offset of the GPS time in the point record, `None` for formats without one.
+    fn gps_offset(&self) -> Option<usize> {
+        if self.extended {
+            Some(22)
+        } else if self.pd.gps_time().is_some() {
+            Some(20)
+        } else {
+            None
+        }
     }
 
     /// At the end of the file: `--scanner ID` on a file whose channels appear only late is

@@ -82,11 +82,12 @@ impl Columns {
         if self.t.is_empty() {
             self.base = b.base;
         }
-        // Grow by an eighth at a time, not by doubling: the window's columns are most of
-        // the stream's memory, and evicting from the front keeps their capacity.
+        // Grow by a 32nd at a time, not by doubling: the window's columns are most of the
+        // stream's memory, and evicting from the front keeps their capacity. Columns this
+        // large are mapped (`one_malloc_arena`), so growing one remaps it without a copy.
         let need = self.t.len() + b.t.len();
         if need > self.t.capacity() {
-            let cap = need + need / 8;
+            let cap = need + need / 32;
             grow(&mut self.x, cap);
             grow(&mut self.y, cap);
             grow(&mut self.z, cap);
