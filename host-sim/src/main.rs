@@ -36,6 +36,7 @@ enum Command {
 }
 
 fn main() {
+    curbtrace_host_sim::stream::malloc::one_arena();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Demo(a) => cli::demo::run(a),

@@ -18,6 +18,7 @@
 //! - [`tasks`] — the campaign cut into independent tasks of whole sections, merged after.
 
 pub mod core_stage;
+pub mod malloc;
 pub mod merge;
 pub mod tasks;
 pub mod window;
@@ -69,7 +70,6 @@ pub fn extract(
     if opts.method != Method::Bend {
         return Err(ExtractError::Method(opts.method.as_str().into()));
     }
-    one_malloc_arena();
     // laz-rs decompresses on rayon's global pool, which nothing else in the stream uses:
     // its threads are named for the reader when the process has not built it yet.
     let _ = rayon::ThreadPoolBuilder::new()
@@ -156,24 +156,6 @@ pub fn extract(
         summary,
     })
 }
-
-/// Asks glibc's malloc for one arena before the stream starts its threads. With an arena
-/// per thread (reader, decoder, core, window) each thread's heap keeps its own freed
-/// batches and section buffers: 11 MB more peak memory on a 3.9 M-point street, for no
-/// measurable CPU (docs/benchmarks.md). Buffers of 1 MiB and more are mapped and unmapped
-/// whole, so the window's columns and a section's index go back to the system when freed.
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-fn one_malloc_arena() {
-    // SAFETY: `mallopt` only sets malloc's parameters; these two are documented for any
-    // time, and later allocations follow them.
-    unsafe {
-        libc::mallopt(libc::M_ARENA_MAX, 1);
-        libc::mallopt(libc::M_MMAP_THRESHOLD, 1 << 20);
-    }
-}
-
-#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-fn one_malloc_arena() {}
 
 /// What the reader thread opens.
 enum SourceSpec {

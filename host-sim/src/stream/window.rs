@@ -84,7 +84,7 @@ impl Columns {
         }
         // Grow by a 32nd at a time, not by doubling: the window's columns are most of the
         // stream's memory, and evicting from the front keeps their capacity. Columns this
-        // large are mapped (`one_malloc_arena`), so growing one remaps it without a copy.
+        // large are mapped (`stream::malloc::one_arena`), so growing one remaps it without a copy.
         let need = self.t.len() + b.t.len();
         if need > self.t.capacity() {
             let cap = need + need / 32;
