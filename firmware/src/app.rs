@@ -87,6 +87,9 @@ pub fn run_observed<R: Read, W: Write, const RING: usize, const N: usize>(
     packet: &mut [u8; MAX_PACKET_LEN],
     mut observe: impl FnMut(&Pipeline<RING, N>, &Summary),
 ) -> Result<Summary, Error<R::Error, W::Error>> {
+    // The firmware sends only what the output mode asks for: in candidates mode the
+    // kernel computes ρ only where the candidates packet depends on it (same packets).
+    pipeline.set_lean_rho(true);
     let mut sink = Sink {
         enc: StreamEncoder::new(),
         packet,

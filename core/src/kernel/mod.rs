@@ -151,6 +151,8 @@ struct Derived {
     /// The smoothing gap squared (0: lines are never split at gaps).
     gap2: f32,
     irregular: bend::Threshold,
+    /// Where a lean ρ pass may skip the arctangent ([`Kernel::set_lean_rho`]).
+    low_cut: bend::LowCut,
 }
 
 impl Derived {
@@ -159,6 +161,7 @@ impl Derived {
         d2: 0.0,
         gap2: 0.0,
         irregular: bend::Threshold::PENDING,
+        low_cut: bend::LowCut::NONE,
     };
 
     fn new(p: &KernelParams) -> Self {
@@ -166,6 +169,7 @@ impl Derived {
             d2: p.d_b_m * p.d_b_m,
             gap2: p.smooth_gap_m * p.smooth_gap_m,
             irregular: bend::Threshold::new(p.irregular_deg),
+            low_cut: bend::LowCut::new(p.tau_min_deg),
         }
     }
 }
@@ -190,6 +194,9 @@ pub struct Kernel<const N: usize> {
     /// `params_hash` and `derived` are still to be computed from `params` (a kernel made
     /// by the `const` [`Kernel::new`] computes them on its first line).
     fresh: bool,
+    /// In candidates mode, ρ only where the candidates packet can depend on it
+    /// ([`Kernel::set_lean_rho`]).
+    lean_rho: bool,
 }
 
 impl<const N: usize> Kernel<N> {
@@ -211,6 +218,7 @@ impl<const N: usize> Kernel<N> {
             s_off: [0; N],
             deque: [0; seed::DEQUE_LEN],
             fresh: true,
+            lean_rho: false,
         }
     }
 
@@ -227,6 +235,17 @@ impl<const N: usize> Kernel<N> {
         self.derived = Derived::new(&params);
         self.fresh = false;
         Ok(())
+    }
+
+    /// With `on`, lines whose parameters ask for [`OutputMode::Candidates`] get ρ only
+    /// where the candidates packet can depend on it: a kept point whose bend angle is
+    /// certainly more than 1° below τ_min (the peak threshold) is given τ_min instead of
+    /// its exact ρ, which spares the arctangent on most points of a road. The nadir, the
+    /// candidates, every peak and every count come out as without it, so the candidates
+    /// packet is the same byte for byte; only `rho_deg` of the other points differs. Off
+    /// by default (every `rho_deg` exact, whatever the mode); the firmware turns it on.
+    pub fn set_lean_rho(&mut self, on: bool) {
+        self.lean_rho = on;
     }
 
     /// Processes one assembled line in place and returns the result borrowed from the
@@ -252,6 +271,7 @@ impl<const N: usize> Kernel<N> {
             d2,
             gap2,
             irregular,
+            low_cut,
         } = self.derived;
         // 0. The points inside the region of interest to the front, in order.
         let n = match p.roi() {
@@ -311,12 +331,24 @@ impl<const N: usize> Kernel<N> {
 
         // 4. ρ on the smoothed line.
         let s_off = &mut s_off[..kept];
-        c.capped_windows +=
-            bend::windows_angles::<M>(xk, zk, d2, s_off, &mut aux[..kept], &mut rho[..kept]);
+        let lean = self.lean_rho && p.output_mode() == OutputMode::Candidates;
+        let (t_off, rk) = (&mut aux[..kept], &mut rho[..kept]);
+        c.capped_windows += if lean {
+            bend::windows_angles::<M, true>(xk, zk, d2, s_off, t_off, rk, low_cut)
+        } else {
+            bend::windows_angles::<M, false>(xk, zk, d2, s_off, t_off, rk, bend::LowCut::NONE)
+        };
         rho[kept..].fill(0.0);
 
         // 5. §2.6: nadir, peaks, candidates (compact indices).
         let nadir = seed::nadir(xk, zk);
+        if let Some(k) = nadir.filter(|_| lean) {
+            // The candidates packet carries the nadir's ρ: exact, as without `lean`.
+            let (s, t) = (k - usize::from(s_off[k]), k + usize::from(aux[k]));
+            if s != k && t != k {
+                rho[k] = bend::bend_angle_deg::<M>(xk, zk, s, k, t);
+            }
+        }
         let seeds = seed::seed_candidates(
             xk,
             zk,

@@ -702,12 +702,13 @@ fn stage_timings() {
     std::println!("windows (smoothed line): {r:.1?} ns/pt");
     let mut rho = std::vec![0f32; n];
     let r = min_med(n, 2000, || {
-        bend::bend_angles::<crate::math::Selected>(
+        bend::bend_angles::<crate::math::Selected, false>(
             core::hint::black_box(&x),
             &z,
             &s_off,
             &t_off,
             &mut rho,
+            bend::LowCut::NONE,
         )
     });
     std::println!("bend_angles: {r:.1?} ns/pt");
@@ -873,4 +874,46 @@ fn a_region_holding_every_point_changes_nothing() {
     assert_eq!(oa.status, ob.status);
     assert_eq!(oa.rho_deg, ob.rho_deg);
     assert_ne!(oa.params_hash, ob.params_hash);
+}
+
+/// The lean ρ pass changes nothing a candidates packet carries (nadir, candidates, their
+/// ρ, every count), skips the arctangent on most points, and is off in points mode.
+#[test]
+fn lean_rho_keeps_the_candidates_packet() {
+    let candidates = KernelParams {
+        output_mode: 1,
+        ..KernelParams::DEFAULT
+    };
+    let mut skipped = 0usize;
+    for (params, lean_applies) in [(candidates, true), (KernelParams::DEFAULT, false)] {
+        for seed in 0..16u64 {
+            let mut buf = std::vec![(0f32, 0f32, 0u32); N];
+            let n = Scene::DEFAULT.generate(&mut Rng(seed), &mut buf);
+            let mut full = Kernel::<N>::new(params);
+            let mut lean = Kernel::<N>::new(params);
+            lean.set_lean_rho(true);
+            let (mut la, mut lb) = (line_from(&buf[..n]), line_from(&buf[..n]));
+            let (a, b) = (full.process(&mut la), lean.process(&mut lb));
+            assert_eq!(a.counters, b.counters, "seed {seed}");
+            assert_eq!((a.nadir, a.left, a.right), (b.nadir, b.left, b.right));
+            assert!(a.left.is_some() && a.right.is_some(), "seed {seed}");
+            assert_eq!(a.status, b.status);
+            assert_eq!(a.x_m, b.x_m);
+            for k in [a.nadir, a.left, a.right].into_iter().flatten() {
+                let k = usize::from(k);
+                assert_eq!(
+                    a.rho_deg[k].to_bits(),
+                    b.rho_deg[k].to_bits(),
+                    "seed {seed}"
+                );
+            }
+            for (&ra, &rb) in a.rho_deg.iter().zip(b.rho_deg) {
+                if ra.to_bits() != rb.to_bits() {
+                    assert!(lean_applies && rb == params.tau_min_deg && ra < rb - 1.0);
+                    skipped += 1;
+                }
+            }
+        }
+    }
+    assert!(skipped > 16 * 1000, "{skipped}");
 }
