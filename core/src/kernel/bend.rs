@@ -480,12 +480,7 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
         rho[j] = if s == j || t == j {
             0.0
         } else {
-            let (cs, d) = bend_cs_d(x, z, s, j, t, (bx, bz));
-            if LEAN && cut.below(cs, d) {
-                cut.floor
-            } else {
-                rho_deg::<M>(cs, d)
-            }
+            lean_or_exact::<M, LEAN>(x, z, s, j, t, (bx, bz), cut)
         };
     }
     capped
@@ -570,6 +565,37 @@ fn bend_angle_deg_b<M: Maths>(
     rho_deg::<M>(cs, d)
 }
 
+/// ρ at `i` with neighbours `s`, `t` and b = p_t − p_i, or with `LEAN` τ_min where `cut`
+/// puts it certainly below (see [`LowCut`]). The sign rule makes the arctangent's first
+/// argument ±c or −|c|, never more than |c|: so |c| < d·tan is tested first, before the
+/// side of the chord is known, and ±c itself after.
+#[inline(always)]
+fn lean_or_exact<M: Maths, const LEAN: bool>(
+    x: &[f32],
+    z: &[f32],
+    s: usize,
+    i: usize,
+    t: usize,
+    b: (f32, f32),
+    cut: LowCut,
+) -> f32 {
+    if LEAN {
+        let (ax, az) = (x[i] - x[s], z[i] - z[s]);
+        let (bx, bz) = b;
+        let (c, d) = (ax * bz - az * bx, ax * bx + az * bz);
+        if cut.below(math::abs(c), d) {
+            return cut.floor;
+        }
+        let (cs, d) = bend_cs_d(x, z, s, i, t, b);
+        if cut.below(cs, d) {
+            return cut.floor;
+        }
+        rho_deg::<M>(cs, d)
+    } else {
+        bend_angle_deg_b::<M>(x, z, s, i, t, b)
+    }
+}
+
 /// The arguments of the bend angle's arctangent at `i` with neighbours `s` and `t` and
 /// b = p_t − p_i: (c with the sign rule applied, d).
 #[inline(always)]
@@ -623,12 +649,7 @@ pub(crate) fn bend_angles<M: Maths, const LEAN: bool>(
         rho[i] = if s == i || t == i {
             0.0
         } else {
-            let (cs, d) = bend_cs_d(x, z, s, i, t, (x[t] - x[i], z[t] - z[i]));
-            if LEAN && cut.below(cs, d) {
-                cut.floor
-            } else {
-                rho_deg::<M>(cs, d)
-            }
+            lean_or_exact::<M, LEAN>(x, z, s, i, t, (x[t] - x[i], z[t] - z[i]), cut)
         };
     }
 }
