@@ -27,11 +27,23 @@ const FULL_POINTS_PACKET: usize = curbtrace_core::wire::HEADER_LEN
     + MAX_POINTS_PER_PACKET * POINT_RECORD_LEN
     + curbtrace_core::wire::CRC_LEN;
 
-/// The ring: one full line of [`MAX_POINTS`] points in packets (the next line keeps
-/// arriving while the kernel works on the last one), plus one packet that may sit in the
-/// ring half-parsed when the line is handed over. 32 × 1304 + 1472 = 43 200 bytes.
-pub const RING: usize =
+/// One full line of [`MAX_POINTS`] points in packets (the next line keeps arriving while
+/// the kernel works on the last one), plus one packet that may sit half-parsed when the
+/// line is handed over: 32 × 1304 + 1472 = 43 200 bytes.
+pub const LINE_RING: usize =
     MAX_POINTS.div_ceil(MAX_POINTS_PER_PACKET) * FULL_POINTS_PACKET + MAX_PACKET_LEN;
+
+/// The ring on the board, where the front end's DMA writes into it: [`LINE_RING`].
+#[cfg(feature = "board")]
+pub const RING: usize = LINE_RING;
+
+/// The ring in the QEMU builds: their bytes reach it through the loop's reads (a file, or
+/// the queue an interrupt fills: `--realtime`, `--usart`), one [`DMA_CHUNK`] at a time,
+/// so it holds one transfer and a packet left half-parsed; what arrives while the kernel
+/// works waits in the queue, which gets the RAM instead (`realtime::QUEUE`).
+#[cfg(not(feature = "board"))]
+pub const RING: usize = 16 * 1024;
+const _: () = assert!(RING >= DMA_CHUNK + MAX_PACKET_LEN);
 
 /// Bytes moved per transfer into the ring (a DMA half-transfer, a `read()` call).
 pub const DMA_CHUNK: usize = 1024;
