@@ -240,10 +240,14 @@ impl<const N: usize> Kernel<N> {
     /// With `on`, lines whose parameters ask for [`OutputMode::Candidates`] get ρ only
     /// where the candidates packet can depend on it: a kept point whose bend angle is
     /// certainly more than 1° below τ_min (the peak threshold) is given τ_min instead of
-    /// its exact ρ, which spares the arctangent on most points of a road. The nadir, the
-    /// candidates, every peak and every count come out as without it, so the candidates
-    /// packet is the same byte for byte; only `rho_deg` of the other points differs. Off
-    /// by default (every `rho_deg` exact, whatever the mode); the firmware turns it on.
+    /// its exact ρ, which spares the arctangent on most points of a road; and only the
+    /// nadir and the two candidates are moved back to their input index (the region's
+    /// partition keeps no points outside, the kept points' partition is not undone). The
+    /// nadir, the candidates with every value the packet carries (tag, x′, z′, ρ, status,
+    /// index) and every count come out as without it, so the candidates packet is the
+    /// same byte for byte; the per-point slices of [`ScanlineOutput`] hold meaningful
+    /// values at those three indices only. Off by default (every slice exact, whatever
+    /// the mode); the firmware, which sends nothing else, turns it on.
     pub fn set_lean_rho(&mut self, on: bool) {
         self.lean_rho = on;
     }
@@ -273,8 +277,16 @@ impl<const N: usize> Kernel<N> {
             irregular,
             low_cut,
         } = self.derived;
+        // What a candidates packet does not carry is not computed (`set_lean_rho`).
+        let lean = self.lean_rho && p.output_mode() == OutputMode::Candidates;
         // 0. The points inside the region of interest to the front, in order.
         let n = match p.roi() {
+            Some(roi) if lean => roi_compact(
+                &mut line.x_m[..n_all],
+                &mut line.z_m[..n_all],
+                &mut line.tag[..n_all],
+                roi,
+            ),
             Some(roi) => roi_partition(
                 &mut line.x_m[..n_all],
                 &mut line.z_m[..n_all],
@@ -331,14 +343,15 @@ impl<const N: usize> Kernel<N> {
 
         // 4. ρ on the smoothed line.
         let s_off = &mut s_off[..kept];
-        let lean = self.lean_rho && p.output_mode() == OutputMode::Candidates;
         let (t_off, rk) = (&mut aux[..kept], &mut rho[..kept]);
         c.capped_windows += if lean {
             bend::windows_angles::<M, true>(xk, zk, d2, s_off, t_off, rk, low_cut)
         } else {
             bend::windows_angles::<M, false>(xk, zk, d2, s_off, t_off, rk, bend::LowCut::NONE)
         };
-        rho[kept..].fill(0.0);
+        if !lean {
+            rho[kept..].fill(0.0);
+        }
 
         // 5. §2.6: nadir, peaks, candidates (compact indices).
         let nadir = seed::nadir(xk, zk);
@@ -367,7 +380,18 @@ impl<const N: usize> Kernel<N> {
 
         // 6. Back to input order: replay the partition's swaps backwards.
         let mut idx = [nadir, seeds.left, seeds.right];
-        if kept == n {
+        if lean {
+            // Only the three points the packet carries go back to their input index.
+            let vals = idx.map(|o| o.map(|k| (x[k], z[k], rho[k], status_of(aux[k]))));
+            if kept < n {
+                idx = lean_unmap(status, first_out, idx);
+            }
+            for (i, v) in idx.iter().zip(vals) {
+                if let (Some(i), Some((xv, zv, rv, st))) = (*i, v) {
+                    (x[i], z[i], rho[i], status[i]) = (xv, zv, rv, st);
+                }
+            }
+        } else if kept == n {
             for (st, &a) in status.iter_mut().zip(aux.iter()) {
                 *st = status_of(a);
             }
@@ -375,8 +399,10 @@ impl<const N: usize> Kernel<N> {
             idx = unpartition(x, z, rho, status, aux, first_out, kept, idx);
         }
         // 7. The points outside the region of interest, behind the others.
-        self.rho[n..n_all].fill(0.0);
-        self.status[n..n_all].fill(PointStatus::OutsideRoi);
+        if !lean {
+            self.rho[n..n_all].fill(0.0);
+            self.status[n..n_all].fill(PointStatus::OutsideRoi);
+        }
         let [nadir, left, right] = idx.map(|o| o.map(|i| i as u16));
 
         ScanlineOutput {
@@ -484,6 +510,57 @@ fn roi_partition(x: &mut [f32], z: &mut [f32], tag: &mut [u32], roi: Roi) -> usi
         }
     }
     w
+}
+
+/// Step 0 in a lean pass ([`Kernel::set_lean_rho`]): the points inside the region of
+/// interest to the front, in order, with their tags, as [`roi_partition`] puts them; the
+/// points outside are overwritten, not kept behind them (the packet does not carry them).
+#[inline(never)]
+fn roi_compact(x: &mut [f32], z: &mut [f32], tag: &mut [u32], roi: Roi) -> usize {
+    let n = tag.len();
+    let (x, z) = (&mut x[..n], &mut z[..n]);
+    let mut w = 0;
+    for i in 0..n {
+        let (xi, zi) = (x[i], z[i]);
+        if roi.contains(xi, zi) {
+            x[w] = xi;
+            z[w] = zi;
+            tag[w] = tag[i];
+            w += 1;
+        }
+    }
+    w
+}
+
+/// Step 6 in a lean pass: the input indices of the compact indices `idx` (the kept points
+/// in input order are the points with status [`PointStatus::Kept`]; points before
+/// `first_out` never moved), without moving any point back.
+#[inline(never)]
+fn lean_unmap(
+    status: &[PointStatus],
+    first_out: usize,
+    idx: [Option<usize>; 3],
+) -> [Option<usize>; 3] {
+    let want = idx.map(|o| o.unwrap_or(usize::MAX));
+    let Some(last) = want.iter().copied().filter(|&o| o != usize::MAX).max() else {
+        return idx;
+    };
+    let mut map = idx;
+    let mut w = first_out;
+    for (i, st) in status.iter().enumerate().skip(first_out) {
+        if w > last {
+            break;
+        }
+        if *st == PointStatus::Kept {
+            for (m, &o) in map.iter_mut().zip(want.iter()) {
+                if o == w {
+                    *m = Some(i);
+                }
+            }
+            w += 1;
+        }
+    }
+    map
 }
 
 /// The status a kept point's `u8` in the working buffer stands for.
