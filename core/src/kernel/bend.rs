@@ -437,7 +437,8 @@ fn windows_sweeps_marked(
 /// windows. On the M4F ρ is computed inside the backward sweep, while p_j and its window
 /// are still in registers; elsewhere it is the two calls. The same values either way
 /// (tested). With `LEAN`, a ρ that [`LowCut::below`] puts below τ_min is not computed:
-/// the point gets τ_min itself (see [`LowCut`]).
+/// the point gets τ_min itself (see [`LowCut`]); and on the M4F the sweep also finds the
+/// nadir (`seed::nadir`), returned as `Some(nadir)` (`None`: not searched).
 pub(crate) fn windows_angles<M: Maths, const LEAN: bool>(
     x: &[f32],
     z: &[f32],
@@ -446,11 +447,11 @@ pub(crate) fn windows_angles<M: Maths, const LEAN: bool>(
     t_off: &mut [u8],
     rho: &mut [f32],
     cut: LowCut,
-) -> u32 {
+) -> (u32, Option<Option<usize>>) {
     if cfg!(target_pointer_width = "64") {
         let capped = windows(x, z, d2, s_off, t_off);
         bend_angles::<M, LEAN>(x, z, s_off, t_off, rho, cut);
-        capped
+        (capped, None)
     } else {
         windows_sweeps_angles::<M, LEAN>(x, z, d2, s_off, t_off, rho, cut)
     }
@@ -468,14 +469,24 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
     t_off: &mut [u8],
     rho: &mut [f32],
     cut: LowCut,
-) -> u32 {
+) -> (u32, Option<Option<usize>>) {
     let n = x.len();
     let (z, s_off, t_off, rho) = (&z[..n], &mut s_off[..n], &mut t_off[..n], &mut rho[..n]);
     let mut capped = forward_sweep(x, z, d2, s_off);
     let mut t = n.saturating_sub(1);
+    // The nadir (`seed::nadir`: smallest |x′| with z′ < 0, the first on a tie): walking
+    // backwards, a tie replaces, so the lowest index wins. The points are finite here
+    // (the kernel set the others aside), so +∞ stands for "none yet".
+    let (mut best, mut nadir) = (f32::INFINITY, usize::MAX);
     for j in (0..n).rev() {
         let (bx, bz) = back_walk(x, z, d2, j, &mut t, &mut capped);
         t_off[j] = (t - j) as u8;
+        if LEAN {
+            let ax = math::abs(x[j]);
+            if z[j] < 0.0 && ax <= best {
+                (best, nadir) = (ax, j);
+            }
+        }
         let s = j - usize::from(s_off[j]);
         rho[j] = if s == j || t == j {
             0.0
@@ -483,7 +494,7 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
             lean_or_exact::<M, LEAN>(x, z, s, j, t, (bx, bz), cut)
         };
     }
-    capped
+    (capped, LEAN.then_some((nadir != usize::MAX).then_some(nadir)))
 }
 
 /// Where a lean ρ pass ([`windows_angles`] with `LEAN`) may skip the arctangent: the
@@ -803,7 +814,7 @@ mod tests {
                     LowCut::NONE,
                 );
                 let (mut s4, mut t4, mut rho4) = ([0u8; N], [0u8; N], [0f32; N]);
-                let c4 = windows_sweeps_angles::<Selected, false>(
+                let (c4, _) = windows_sweeps_angles::<Selected, false>(
                     &x[..n],
                     &z[..n],
                     d2,
@@ -827,7 +838,7 @@ mod tests {
                 let mut rho5 = [0f32; N];
                 bend_angles::<Selected, true>(&x[..n], &z[..n], &s1, &t1, &mut rho5[..n], cut);
                 let (mut s6, mut t6, mut rho6) = ([0u8; N], [0u8; N], [0f32; N]);
-                windows_sweeps_angles::<Selected, true>(
+                let (_, nd) = windows_sweeps_angles::<Selected, true>(
                     &x[..n],
                     &z[..n],
                     d2,
@@ -836,6 +847,10 @@ mod tests {
                     &mut rho6[..n],
                     cut,
                 );
+                if case % 3 != 1 && !(case % 4 != 0 && case % 5 == 2) {
+                    // Finite points in range only: the sweep's nadir is `seed::nadir`'s.
+                    assert_eq!(nd, Some(super::super::seed::nadir(&x[..n], &z[..n])));
+                }
                 for i in 0..n {
                     let (a, b, c) = (rho1[i], rho5[i], rho6[i]);
                     assert!(b.to_bits() == c.to_bits() || (b.is_nan() && c.is_nan()));

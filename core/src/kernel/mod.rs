@@ -344,17 +344,18 @@ impl<const N: usize> Kernel<N> {
         // 4. ρ on the smoothed line.
         let s_off = &mut s_off[..kept];
         let (t_off, rk) = (&mut aux[..kept], &mut rho[..kept]);
-        c.capped_windows += if lean {
+        let (capped, swept_nadir) = if lean {
             bend::windows_angles::<M, true>(xk, zk, d2, s_off, t_off, rk, low_cut)
         } else {
             bend::windows_angles::<M, false>(xk, zk, d2, s_off, t_off, rk, bend::LowCut::NONE)
         };
+        c.capped_windows += capped;
         if !lean {
             rho[kept..].fill(0.0);
         }
 
         // 5. §2.6: nadir, peaks, candidates (compact indices).
-        let nadir = seed::nadir(xk, zk);
+        let nadir = swept_nadir.unwrap_or_else(|| seed::nadir(xk, zk));
         if let Some(k) = nadir.filter(|_| lean) {
             // The candidates packet carries the nadir's ρ: exact, as without `lean`.
             let (s, t) = (k - usize::from(s_off[k]), k + usize::from(aux[k]));
