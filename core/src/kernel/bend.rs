@@ -494,7 +494,10 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
             lean_or_exact::<M, LEAN>(x, z, s, j, t, (bx, bz), cut)
         };
     }
-    (capped, LEAN.then_some((nadir != usize::MAX).then_some(nadir)))
+    (
+        capped,
+        LEAN.then_some((nadir != usize::MAX).then_some(nadir)),
+    )
 }
 
 /// Where a lean ρ pass ([`windows_angles`] with `LEAN`) may skip the arctangent: the

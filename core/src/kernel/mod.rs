@@ -356,25 +356,32 @@ impl<const N: usize> Kernel<N> {
 
         // 5. §2.6: nadir, peaks, candidates (compact indices).
         let nadir = swept_nadir.unwrap_or_else(|| seed::nadir(xk, zk));
+        let mut nadir_status = PointStatus::Kept;
         if let Some(k) = nadir.filter(|_| lean) {
-            // The candidates packet carries the nadir's ρ: exact, as without `lean`.
+            // The candidates packet carries the nadir's ρ and status: as without `lean`.
             let (s, t) = (k - usize::from(s_off[k]), k + usize::from(aux[k]));
             if s != k && t != k {
                 rho[k] = bend::bend_angle_deg::<M>(xk, zk, s, k, t);
+            } else {
+                nadir_status = PointStatus::NoNeighbour;
             }
         }
-        let seeds = seed::seed_candidates(
-            xk,
-            zk,
+        let args = seed::SeedArgs {
+            x: xk,
+            z: zk,
             gap2,
-            &rho[..kept],
+            rho: &rho[..kept],
             s_off,
-            &mut aux[..kept],
-            p.tau_min_deg,
-            p.tau_max_deg,
+            tau_min: p.tau_min_deg,
+            tau_max: p.tau_max_deg,
             nadir,
-            &mut self.deque,
-        );
+        };
+        let seeds = if lean {
+            // Statuses of the candidates are Kept (peaks have both neighbours).
+            seed::seed_candidates::<false>(args, &mut aux[..kept], &mut self.deque)
+        } else {
+            seed::seed_candidates::<true>(args, &mut aux[..kept], &mut self.deque)
+        };
         c.peaks = seeds.peaks;
         c.no_neighbour = seeds.no_neighbour;
         c.kept = kept as u32 - seeds.no_neighbour;
@@ -383,7 +390,9 @@ impl<const N: usize> Kernel<N> {
         let mut idx = [nadir, seeds.left, seeds.right];
         if lean {
             // Only the three points the packet carries go back to their input index.
-            let vals = idx.map(|o| o.map(|k| (x[k], z[k], rho[k], status_of(aux[k]))));
+            let st = [nadir_status, PointStatus::Kept, PointStatus::Kept];
+            let vals =
+                core::array::from_fn::<_, 3, _>(|j| idx[j].map(|k| (x[k], z[k], rho[k], st[j])));
             if kept < n {
                 idx = lean_unmap(status, first_out, idx);
             }

@@ -892,7 +892,10 @@ fn lean_pass_keeps_the_candidates_packet() {
         roi_z_max_m: -1.7,
         ..candidates
     };
-    let points = KernelParams { output_mode: 0, ..roi };
+    let points = KernelParams {
+        output_mode: 0,
+        ..roi
+    };
     let mut skipped = 0usize;
     for (params, lean_applies) in [(candidates, true), (roi, true), (points, false)] {
         for seed in 0..16u64 {
@@ -928,7 +931,11 @@ fn lean_pass_keeps_the_candidates_packet() {
                 assert_eq!(a.status, b.status);
                 assert_eq!(a.x_m, b.x_m);
             }
-            skipped += b.rho_deg.iter().filter(|&&r| r == params.tau_min_deg).count();
+            skipped += b
+                .rho_deg
+                .iter()
+                .filter(|&&r| r == params.tau_min_deg)
+                .count();
         }
     }
     assert!(skipped > 16 * 1000, "{skipped}");
