@@ -25,6 +25,16 @@
 //! partition's order; the tags join each point to its source. Undoing it cost more than
 //! the rest of the kernel saved on the points outside (`docs/benchmarks.md`).
 //!
+//! # Lean pass (candidates mode, [`Kernel::set_lean_rho`])
+//!
+//! A candidates packet carries the nadir, the two candidates and the counts, nothing else.
+//! With the lean pass on (the firmware's choice; off by default), a line in candidates mode
+//! computes no more than that needs: no arctangent where ρ is certainly below τ_min
+//! ([`bend::LowCut`]), the region's points compacted rather than partitioned, the kept
+//! points' partition not undone (only the three indices mapped back), no per-point
+//! statuses, the nadir found inside the smoothed pass's sweep. The packet is the same byte
+//! for byte (tested, and compared on whole streams by `firmware/check.sh`).
+//!
 //! # Memory
 //!
 //! Per point of capacity `N`: the line's x′, z′, tag (12 bytes) plus the kernel's ρ (`f32`),

@@ -901,15 +901,17 @@ fn lean_pass_keeps_the_candidates_packet() {
         for seed in 0..16u64 {
             let mut buf = std::vec![(0f32, 0f32, 0u32); N];
             let n = Scene::DEFAULT.generate(&mut Rng(seed), &mut buf);
-            // A spike and a non-finite point, so the kept points' partition moves points.
-            buf[n / 3].1 += 0.5;
+            // A spike and a non-finite point, so the kept points' partition moves points
+            // (a region may hold them outside).
+            buf[n / 3].1 += 0.1;
             buf[n / 2].0 = f32::NAN;
             let mut full = Kernel::<N>::new(params);
             let mut lean = Kernel::<N>::new(params);
             lean.set_lean_rho(true);
             let (mut la, mut lb) = (line_from(&buf[..n]), line_from(&buf[..n]));
             let (a, b) = (full.process(&mut la), lean.process(&mut lb));
-            assert!(a.counters.irregular + a.counters.non_finite >= 2);
+            let set_aside = a.counters.irregular + a.counters.non_finite;
+            assert!(set_aside >= 2 || params.roi().is_some(), "seed {seed}");
             assert_eq!(a.counters, b.counters, "seed {seed}");
             assert_eq!((a.nadir, a.left, a.right), (b.nadir, b.left, b.right));
             assert!(a.left.is_some() && a.right.is_some(), "seed {seed}");
@@ -927,9 +929,10 @@ fn lean_pass_keeps_the_candidates_packet() {
                 assert_eq!(at(&a), at(&b), "seed {seed} point {k}");
             }
             if !lean_applies {
-                assert_eq!(a.rho_deg, b.rho_deg);
+                let bits = |v: &[f32]| v.iter().map(|f| f.to_bits()).collect::<Vec<u32>>();
+                assert_eq!(bits(a.rho_deg), bits(b.rho_deg));
+                assert_eq!(bits(a.x_m), bits(b.x_m));
                 assert_eq!(a.status, b.status);
-                assert_eq!(a.x_m, b.x_m);
             }
             skipped += b
                 .rho_deg
