@@ -522,6 +522,7 @@ impl LowCut {
     };
 
     /// The cut for τ_min = `tau_min_deg`; [`LowCut::NONE`] when τ_min ≤ 1° (no margin).
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN takes NONE too
     pub(crate) fn new(tau_min_deg: f32) -> Self {
         if !(tau_min_deg > 1.0) {
             return Self::NONE;
