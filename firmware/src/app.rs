@@ -322,7 +322,10 @@ mod tests {
     #[test]
     fn the_observer_sees_every_transfer_and_the_lines_so_far() {
         let input = stream(&KernelParams::DEFAULT.to_words(), 3, 300);
-        let mut node: Box<Pipeline<RING, 512>> = Box::default();
+        // A ring larger than the input: every transfer is a whole `step`, none cut at
+        // the wrap.
+        assert!(LINE_RING > input.len());
+        let mut node: Box<Pipeline<LINE_RING, 512>> = Box::default();
         let mut packet = [0u8; MAX_PACKET_LEN];
         let mut out = Sink(Vec::new());
         let step = 500;
