@@ -196,6 +196,12 @@ impl<const RING: usize, const N: usize> Pipeline<RING, N> {
     pub fn params(&self) -> &KernelParams {
         self.kernel.params()
     }
+
+    /// [`Kernel::set_lean_rho`]: in candidates mode, ρ only where the candidates packet
+    /// can depend on it (the packets are the same; the firmware turns it on).
+    pub fn set_lean_rho(&mut self, on: bool) {
+        self.kernel.set_lean_rho(on);
+    }
 }
 
 impl<const RING: usize, const N: usize> Default for Pipeline<RING, N> {

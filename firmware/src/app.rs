@@ -27,11 +27,23 @@ const FULL_POINTS_PACKET: usize = curbtrace_core::wire::HEADER_LEN
     + MAX_POINTS_PER_PACKET * POINT_RECORD_LEN
     + curbtrace_core::wire::CRC_LEN;
 
-/// The ring: one full line of [`MAX_POINTS`] points in packets (the next line keeps
-/// arriving while the kernel works on the last one), plus one packet that may sit in the
-/// ring half-parsed when the line is handed over. 32 × 1304 + 1472 = 43 200 bytes.
-pub const RING: usize =
+/// One full line of [`MAX_POINTS`] points in packets (the next line keeps arriving while
+/// the kernel works on the last one), plus one packet that may sit half-parsed when the
+/// line is handed over: 32 × 1304 + 1472 = 43 200 bytes.
+pub const LINE_RING: usize =
     MAX_POINTS.div_ceil(MAX_POINTS_PER_PACKET) * FULL_POINTS_PACKET + MAX_PACKET_LEN;
+
+/// The ring on the board, where the front end's DMA writes into it: [`LINE_RING`].
+#[cfg(feature = "board")]
+pub const RING: usize = LINE_RING;
+
+/// The ring in the QEMU builds: their bytes reach it through the loop's reads (a file, or
+/// the queue an interrupt fills: `--realtime`, `--usart`), one [`DMA_CHUNK`] at a time,
+/// so it holds one transfer and a packet left half-parsed; what arrives while the kernel
+/// works waits in the queue, which gets the RAM instead (`realtime::QUEUE`).
+#[cfg(not(feature = "board"))]
+pub const RING: usize = 16 * 1024;
+const _: () = assert!(RING >= DMA_CHUNK + MAX_PACKET_LEN);
 
 /// Bytes moved per transfer into the ring (a DMA half-transfer, a `read()` call).
 pub const DMA_CHUNK: usize = 1024;
@@ -87,6 +99,9 @@ pub fn run_observed<R: Read, W: Write, const RING: usize, const N: usize>(
     packet: &mut [u8; MAX_PACKET_LEN],
     mut observe: impl FnMut(&Pipeline<RING, N>, &Summary),
 ) -> Result<Summary, Error<R::Error, W::Error>> {
+    // The firmware sends only what the output mode asks for: in candidates mode the
+    // kernel computes ρ only where the candidates packet depends on it (same packets).
+    pipeline.set_lean_rho(true);
     let mut sink = Sink {
         enc: StreamEncoder::new(),
         packet,
@@ -307,7 +322,10 @@ mod tests {
     #[test]
     fn the_observer_sees_every_transfer_and_the_lines_so_far() {
         let input = stream(&KernelParams::DEFAULT.to_words(), 3, 300);
-        let mut node: Box<Pipeline<RING, 512>> = Box::default();
+        // A ring larger than the input: every transfer is a whole `step`, none cut at
+        // the wrap.
+        assert!(LINE_RING > input.len());
+        let mut node: Box<Pipeline<LINE_RING, 512>> = Box::default();
         let mut packet = [0u8; MAX_PACKET_LEN];
         let mut out = Sink(Vec::new());
         let step = 500;

@@ -436,21 +436,24 @@ fn windows_sweeps_marked(
 /// [`windows`] and then [`bend_angles`] on the (smoothed) line: returns the capped
 /// windows. On the M4F ρ is computed inside the backward sweep, while p_j and its window
 /// are still in registers; elsewhere it is the two calls. The same values either way
-/// (tested).
-pub(crate) fn windows_angles<M: Maths>(
+/// (tested). With `LEAN`, a ρ that [`LowCut::below`] puts below τ_min is not computed:
+/// the point gets τ_min itself (see [`LowCut`]); and on the M4F the sweep also finds the
+/// nadir (`seed::nadir`), returned as `Some(nadir)` (`None`: not searched).
+pub(crate) fn windows_angles<M: Maths, const LEAN: bool>(
     x: &[f32],
     z: &[f32],
     d2: f32,
     s_off: &mut [u8],
     t_off: &mut [u8],
     rho: &mut [f32],
-) -> u32 {
+    cut: LowCut,
+) -> (u32, Option<Option<usize>>) {
     if cfg!(target_pointer_width = "64") {
         let capped = windows(x, z, d2, s_off, t_off);
-        bend_angles::<M>(x, z, s_off, t_off, rho);
-        capped
+        bend_angles::<M, LEAN>(x, z, s_off, t_off, rho, cut);
+        (capped, None)
     } else {
-        windows_sweeps_angles::<M>(x, z, d2, s_off, t_off, rho)
+        windows_sweeps_angles::<M, LEAN>(x, z, d2, s_off, t_off, rho, cut)
     }
 }
 
@@ -458,29 +461,85 @@ pub(crate) fn windows_angles<M: Maths>(
 #[inline(never)] // its own registers (see `mark_irregular`)
 #[cfg_attr(all(not(test), target_pointer_width = "64"), allow(dead_code))]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN counts as beyond, as in `beyond`
-fn windows_sweeps_angles<M: Maths>(
+fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
     x: &[f32],
     z: &[f32],
     d2: f32,
     s_off: &mut [u8],
     t_off: &mut [u8],
     rho: &mut [f32],
-) -> u32 {
+    cut: LowCut,
+) -> (u32, Option<Option<usize>>) {
     let n = x.len();
     let (z, s_off, t_off, rho) = (&z[..n], &mut s_off[..n], &mut t_off[..n], &mut rho[..n]);
     let mut capped = forward_sweep(x, z, d2, s_off);
     let mut t = n.saturating_sub(1);
+    // The nadir (`seed::nadir`: smallest |x′| with z′ < 0, the first on a tie): walking
+    // backwards, a tie replaces, so the lowest index wins. The points are finite here
+    // (the kernel set the others aside), so +∞ stands for "none yet".
+    let (mut best, mut nadir) = (f32::INFINITY, usize::MAX);
     for j in (0..n).rev() {
         let (bx, bz) = back_walk(x, z, d2, j, &mut t, &mut capped);
         t_off[j] = (t - j) as u8;
+        if LEAN {
+            let ax = math::abs(x[j]);
+            if z[j] < 0.0 && ax <= best {
+                (best, nadir) = (ax, j);
+            }
+        }
         let s = j - usize::from(s_off[j]);
         rho[j] = if s == j || t == j {
             0.0
         } else {
-            bend_angle_deg_b::<M>(x, z, s, j, t, (bx, bz))
+            lean_or_exact::<M, LEAN>(x, z, s, j, t, (bx, bz), cut)
         };
     }
-    capped
+    (
+        capped,
+        LEAN.then_some((nadir != usize::MAX).then_some(nadir)),
+    )
+}
+
+/// Where a lean ρ pass ([`windows_angles`] with `LEAN`) may skip the arctangent: the
+/// bend angle is certainly below τ_min, so the exact value cannot make a peak nor stop
+/// one (a peak's ρ is above τ_min and only larger values in its window count), and the
+/// point gets τ_min itself. The test leaves a margin of 1° below τ_min, far more than the
+/// arctangent's error (libm 2 ulp, micromath 0.16°) and the test's own rounding, so every
+/// ρ within 1° of τ_min or above is computed exactly.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LowCut {
+    /// tan(min(τ_min, 90°) − 1°).
+    tan: f32,
+    /// τ_min, degrees: the value a skipped point gets.
+    floor: f32,
+}
+
+impl LowCut {
+    /// A cut that skips nothing.
+    pub(crate) const NONE: Self = Self {
+        tan: f32::NEG_INFINITY,
+        floor: 0.0,
+    };
+
+    /// The cut for τ_min = `tau_min_deg`; [`LowCut::NONE`] when τ_min ≤ 1° (no margin).
+    #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN takes NONE too
+    pub(crate) fn new(tau_min_deg: f32) -> Self {
+        if !(tau_min_deg > 1.0) {
+            return Self::NONE;
+        }
+        let a = (tau_min_deg.min(90.0) - 1.0) / RAD_TO_DEG;
+        Self {
+            tan: math::sin(a) / math::cos(a),
+            floor: tau_min_deg,
+        }
+    }
+
+    /// Whether atan2(`cs`, `d`) is certainly more than 1° below τ_min: d > 0 (the angle
+    /// lies in (−90°, 90°)) and cs / d < tan(τ_min − 1°). NaN never is.
+    #[inline(always)]
+    fn below(&self, cs: f32, d: f32) -> bool {
+        d > 0.0 && cs < d * self.tan
+    }
 }
 
 /// Whether the d_b window [s, t] of a point is cut short by the end of its piece of line: the
@@ -517,6 +576,45 @@ fn bend_angle_deg_b<M: Maths>(
     t: usize,
     b: (f32, f32),
 ) -> f32 {
+    let (cs, d) = bend_cs_d(x, z, s, i, t, b);
+    rho_deg::<M>(cs, d)
+}
+
+/// ρ at `i` with neighbours `s`, `t` and b = p_t − p_i, or with `LEAN` τ_min where `cut`
+/// puts it certainly below (see [`LowCut`]). The sign rule makes the arctangent's first
+/// argument ±c or −|c|, never more than |c|: so |c| < d·tan is tested first, before the
+/// side of the chord is known, and ±c itself after.
+#[inline(always)]
+fn lean_or_exact<M: Maths, const LEAN: bool>(
+    x: &[f32],
+    z: &[f32],
+    s: usize,
+    i: usize,
+    t: usize,
+    b: (f32, f32),
+    cut: LowCut,
+) -> f32 {
+    if LEAN {
+        let (ax, az) = (x[i] - x[s], z[i] - z[s]);
+        let (bx, bz) = b;
+        let (c, d) = (ax * bz - az * bx, ax * bx + az * bz);
+        if cut.below(math::abs(c), d) {
+            return cut.floor;
+        }
+        let (cs, d) = bend_cs_d(x, z, s, i, t, b);
+        if cut.below(cs, d) {
+            return cut.floor;
+        }
+        rho_deg::<M>(cs, d)
+    } else {
+        bend_angle_deg_b::<M>(x, z, s, i, t, b)
+    }
+}
+
+/// The arguments of the bend angle's arctangent at `i` with neighbours `s` and `t` and
+/// b = p_t − p_i: (c with the sign rule applied, d).
+#[inline(always)]
+fn bend_cs_d(x: &[f32], z: &[f32], s: usize, i: usize, t: usize, b: (f32, f32)) -> (f32, f32) {
     let (xs, zs, xi, zi, xt, zt) = (x[s], z[s], x[i], z[i], x[t], z[t]);
     let (ax, az) = (xi - xs, zi - zs);
     let (bx, bz) = b;
@@ -532,6 +630,12 @@ fn bend_angle_deg_b<M: Maths>(
     } else {
         -math::abs(c)
     };
+    (cs, d)
+}
+
+/// The bend angle in degrees, (−180, 180], from [`bend_cs_d`]'s arguments.
+#[inline(always)]
+fn rho_deg<M: Maths>(cs: f32, d: f32) -> f32 {
     let r = M::atan2(cs, d) * RAD_TO_DEG;
     // (−180, 180]; also clamps an approximate backend's overshoot.
     if r <= -180.0 || r > 180.0 {
@@ -542,14 +646,15 @@ fn bend_angle_deg_b<M: Maths>(
 }
 
 /// ρ on the (smoothed) line for every point, with the offsets from [`windows`]; 0 where a
-/// side has no neighbour.
+/// side has no neighbour. `LEAN` and `cut` as in [`windows_angles`].
 #[inline(never)] // its own registers (see `mark_irregular`)
-pub(crate) fn bend_angles<M: Maths>(
+pub(crate) fn bend_angles<M: Maths, const LEAN: bool>(
     x: &[f32],
     z: &[f32],
     s_off: &[u8],
     t_off: &[u8],
     rho: &mut [f32],
+    cut: LowCut,
 ) {
     let n = x.len();
     let (z, s_off, t_off, rho) = (&z[..n], &s_off[..n], &t_off[..n], &mut rho[..n]);
@@ -559,7 +664,7 @@ pub(crate) fn bend_angles<M: Maths>(
         rho[i] = if s == i || t == i {
             0.0
         } else {
-            bend_angle_deg::<M>(x, z, s, i, t)
+            lean_or_exact::<M, LEAN>(x, z, s, i, t, (x[t] - x[i], z[t] - z[i]), cut)
         };
     }
 }
@@ -704,15 +809,23 @@ mod tests {
                 assert_eq!(st3[..n], st1[..n], "case {case} d2 {d2}");
                 // The fused angles give what the separate pass gives.
                 let mut rho1 = [0f32; N];
-                bend_angles::<Selected>(&x[..n], &z[..n], &s1, &t1, &mut rho1[..n]);
+                bend_angles::<Selected, false>(
+                    &x[..n],
+                    &z[..n],
+                    &s1,
+                    &t1,
+                    &mut rho1[..n],
+                    LowCut::NONE,
+                );
                 let (mut s4, mut t4, mut rho4) = ([0u8; N], [0u8; N], [0f32; N]);
-                let c4 = windows_sweeps_angles::<Selected>(
+                let (c4, _) = windows_sweeps_angles::<Selected, false>(
                     &x[..n],
                     &z[..n],
                     d2,
                     &mut s4,
                     &mut t4,
                     &mut rho4[..n],
+                    LowCut::NONE,
                 );
                 assert_eq!(c4, c1, "case {case} d2 {d2}");
                 assert_eq!((s4, t4), (s1, t1));
@@ -720,6 +833,34 @@ mod tests {
                     let (a, b) = (rho1[i], rho4[i]);
                     assert!(
                         a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                        "case {case} d2 {d2} i {i}: {a} {b}"
+                    );
+                }
+                // The lean pass: the same ρ wherever it computes one, τ_min where it
+                // skips one more than 1° below τ_min; both forms alike.
+                let cut = LowCut::new(30.0);
+                let mut rho5 = [0f32; N];
+                bend_angles::<Selected, true>(&x[..n], &z[..n], &s1, &t1, &mut rho5[..n], cut);
+                let (mut s6, mut t6, mut rho6) = ([0u8; N], [0u8; N], [0f32; N]);
+                let (_, nd) = windows_sweeps_angles::<Selected, true>(
+                    &x[..n],
+                    &z[..n],
+                    d2,
+                    &mut s6,
+                    &mut t6,
+                    &mut rho6[..n],
+                    cut,
+                );
+                if case % 3 != 1 && !(case % 4 != 0 && case % 5 == 2) {
+                    // Finite points in range only: the sweep's nadir is `seed::nadir`'s.
+                    assert_eq!(nd, Some(super::super::seed::nadir(&x[..n], &z[..n])));
+                }
+                for i in 0..n {
+                    let (a, b, c) = (rho1[i], rho5[i], rho6[i]);
+                    assert!(b.to_bits() == c.to_bits() || (b.is_nan() && c.is_nan()));
+                    let same = a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
+                    assert!(
+                        same || (b == 30.0 && a < 29.0),
                         "case {case} d2 {d2} i {i}: {a} {b}"
                     );
                 }

@@ -25,6 +25,16 @@
 //! partition's order; the tags join each point to its source. Undoing it cost more than
 //! the rest of the kernel saved on the points outside (`docs/benchmarks.md`).
 //!
+//! # Lean pass (candidates mode, [`Kernel::set_lean_rho`])
+//!
+//! A candidates packet carries the nadir, the two candidates and the counts, nothing else.
+//! With the lean pass on (the firmware's choice; off by default), a line in candidates mode
+//! computes no more than that needs: no arctangent where ρ is certainly below τ_min
+//! ([`bend::LowCut`]), the region's points compacted rather than partitioned, the kept
+//! points' partition not undone (only the three indices mapped back), no per-point
+//! statuses, the nadir found inside the smoothed pass's sweep. The packet is the same byte
+//! for byte (tested, and compared on whole streams by `firmware/check.sh`).
+//!
 //! # Memory
 //!
 //! Per point of capacity `N`: the line's x′, z′, tag (12 bytes) plus the kernel's ρ (`f32`),
@@ -151,6 +161,8 @@ struct Derived {
     /// The smoothing gap squared (0: lines are never split at gaps).
     gap2: f32,
     irregular: bend::Threshold,
+    /// Where a lean ρ pass may skip the arctangent ([`Kernel::set_lean_rho`]).
+    low_cut: bend::LowCut,
 }
 
 impl Derived {
@@ -159,6 +171,7 @@ impl Derived {
         d2: 0.0,
         gap2: 0.0,
         irregular: bend::Threshold::PENDING,
+        low_cut: bend::LowCut::NONE,
     };
 
     fn new(p: &KernelParams) -> Self {
@@ -166,6 +179,7 @@ impl Derived {
             d2: p.d_b_m * p.d_b_m,
             gap2: p.smooth_gap_m * p.smooth_gap_m,
             irregular: bend::Threshold::new(p.irregular_deg),
+            low_cut: bend::LowCut::new(p.tau_min_deg),
         }
     }
 }
@@ -190,6 +204,9 @@ pub struct Kernel<const N: usize> {
     /// `params_hash` and `derived` are still to be computed from `params` (a kernel made
     /// by the `const` [`Kernel::new`] computes them on its first line).
     fresh: bool,
+    /// In candidates mode, ρ only where the candidates packet can depend on it
+    /// ([`Kernel::set_lean_rho`]).
+    lean_rho: bool,
 }
 
 impl<const N: usize> Kernel<N> {
@@ -211,6 +228,7 @@ impl<const N: usize> Kernel<N> {
             s_off: [0; N],
             deque: [0; seed::DEQUE_LEN],
             fresh: true,
+            lean_rho: false,
         }
     }
 
@@ -227,6 +245,21 @@ impl<const N: usize> Kernel<N> {
         self.derived = Derived::new(&params);
         self.fresh = false;
         Ok(())
+    }
+
+    /// With `on`, lines whose parameters ask for [`OutputMode::Candidates`] get ρ only
+    /// where the candidates packet can depend on it: a kept point whose bend angle is
+    /// certainly more than 1° below τ_min (the peak threshold) is given τ_min instead of
+    /// its exact ρ, which spares the arctangent on most points of a road; and only the
+    /// nadir and the two candidates are moved back to their input index (the region's
+    /// partition keeps no points outside, the kept points' partition is not undone). The
+    /// nadir, the candidates with every value the packet carries (tag, x′, z′, ρ, status,
+    /// index) and every count come out as without it, so the candidates packet is the
+    /// same byte for byte; the per-point slices of [`ScanlineOutput`] hold meaningful
+    /// values at those three indices only. Off by default (every slice exact, whatever
+    /// the mode); the firmware, which sends nothing else, turns it on.
+    pub fn set_lean_rho(&mut self, on: bool) {
+        self.lean_rho = on;
     }
 
     /// Processes one assembled line in place and returns the result borrowed from the
@@ -252,9 +285,18 @@ impl<const N: usize> Kernel<N> {
             d2,
             gap2,
             irregular,
+            low_cut,
         } = self.derived;
+        // What a candidates packet does not carry is not computed (`set_lean_rho`).
+        let lean = self.lean_rho && p.output_mode() == OutputMode::Candidates;
         // 0. The points inside the region of interest to the front, in order.
         let n = match p.roi() {
+            Some(roi) if lean => roi_compact(
+                &mut line.x_m[..n_all],
+                &mut line.z_m[..n_all],
+                &mut line.tag[..n_all],
+                roi,
+            ),
             Some(roi) => roi_partition(
                 &mut line.x_m[..n_all],
                 &mut line.z_m[..n_all],
@@ -311,31 +353,65 @@ impl<const N: usize> Kernel<N> {
 
         // 4. ρ on the smoothed line.
         let s_off = &mut s_off[..kept];
-        c.capped_windows +=
-            bend::windows_angles::<M>(xk, zk, d2, s_off, &mut aux[..kept], &mut rho[..kept]);
-        rho[kept..].fill(0.0);
+        let (t_off, rk) = (&mut aux[..kept], &mut rho[..kept]);
+        let (capped, swept_nadir) = if lean {
+            bend::windows_angles::<M, true>(xk, zk, d2, s_off, t_off, rk, low_cut)
+        } else {
+            bend::windows_angles::<M, false>(xk, zk, d2, s_off, t_off, rk, bend::LowCut::NONE)
+        };
+        c.capped_windows += capped;
+        if !lean {
+            rho[kept..].fill(0.0);
+        }
 
         // 5. §2.6: nadir, peaks, candidates (compact indices).
-        let nadir = seed::nadir(xk, zk);
-        let seeds = seed::seed_candidates(
-            xk,
-            zk,
+        let nadir = swept_nadir.unwrap_or_else(|| seed::nadir(xk, zk));
+        let mut nadir_status = PointStatus::Kept;
+        if let Some(k) = nadir.filter(|_| lean) {
+            // The candidates packet carries the nadir's ρ and status: as without `lean`.
+            let (s, t) = (k - usize::from(s_off[k]), k + usize::from(aux[k]));
+            if s != k && t != k {
+                rho[k] = bend::bend_angle_deg::<M>(xk, zk, s, k, t);
+            } else {
+                nadir_status = PointStatus::NoNeighbour;
+            }
+        }
+        let args = seed::SeedArgs {
+            x: xk,
+            z: zk,
             gap2,
-            &rho[..kept],
+            rho: &rho[..kept],
             s_off,
-            &mut aux[..kept],
-            p.tau_min_deg,
-            p.tau_max_deg,
+            tau_min: p.tau_min_deg,
+            tau_max: p.tau_max_deg,
             nadir,
-            &mut self.deque,
-        );
+        };
+        let seeds = if lean {
+            // Statuses of the candidates are Kept (peaks have both neighbours).
+            seed::seed_candidates::<false>(args, &mut aux[..kept], &mut self.deque)
+        } else {
+            seed::seed_candidates::<true>(args, &mut aux[..kept], &mut self.deque)
+        };
         c.peaks = seeds.peaks;
         c.no_neighbour = seeds.no_neighbour;
         c.kept = kept as u32 - seeds.no_neighbour;
 
         // 6. Back to input order: replay the partition's swaps backwards.
         let mut idx = [nadir, seeds.left, seeds.right];
-        if kept == n {
+        if lean {
+            // Only the three points the packet carries go back to their input index.
+            let st = [nadir_status, PointStatus::Kept, PointStatus::Kept];
+            let vals =
+                core::array::from_fn::<_, 3, _>(|j| idx[j].map(|k| (x[k], z[k], rho[k], st[j])));
+            if kept < n {
+                idx = lean_unmap(status, first_out, idx);
+            }
+            for (i, v) in idx.iter().zip(vals) {
+                if let (Some(i), Some((xv, zv, rv, st))) = (*i, v) {
+                    (x[i], z[i], rho[i], status[i]) = (xv, zv, rv, st);
+                }
+            }
+        } else if kept == n {
             for (st, &a) in status.iter_mut().zip(aux.iter()) {
                 *st = status_of(a);
             }
@@ -343,8 +419,10 @@ impl<const N: usize> Kernel<N> {
             idx = unpartition(x, z, rho, status, aux, first_out, kept, idx);
         }
         // 7. The points outside the region of interest, behind the others.
-        self.rho[n..n_all].fill(0.0);
-        self.status[n..n_all].fill(PointStatus::OutsideRoi);
+        if !lean {
+            self.rho[n..n_all].fill(0.0);
+            self.status[n..n_all].fill(PointStatus::OutsideRoi);
+        }
         let [nadir, left, right] = idx.map(|o| o.map(|i| i as u16));
 
         ScanlineOutput {
@@ -452,6 +530,57 @@ fn roi_partition(x: &mut [f32], z: &mut [f32], tag: &mut [u32], roi: Roi) -> usi
         }
     }
     w
+}
+
+/// Step 0 in a lean pass ([`Kernel::set_lean_rho`]): the points inside the region of
+/// interest to the front, in order, with their tags, as [`roi_partition`] puts them; the
+/// points outside are overwritten, not kept behind them (the packet does not carry them).
+#[inline(never)]
+fn roi_compact(x: &mut [f32], z: &mut [f32], tag: &mut [u32], roi: Roi) -> usize {
+    let n = tag.len();
+    let (x, z) = (&mut x[..n], &mut z[..n]);
+    let mut w = 0;
+    for i in 0..n {
+        let (xi, zi) = (x[i], z[i]);
+        if roi.contains(xi, zi) {
+            x[w] = xi;
+            z[w] = zi;
+            tag[w] = tag[i];
+            w += 1;
+        }
+    }
+    w
+}
+
+/// Step 6 in a lean pass: the input indices of the compact indices `idx` (the kept points
+/// in input order are the points with status [`PointStatus::Kept`]; points before
+/// `first_out` never moved), without moving any point back.
+#[inline(never)]
+fn lean_unmap(
+    status: &[PointStatus],
+    first_out: usize,
+    idx: [Option<usize>; 3],
+) -> [Option<usize>; 3] {
+    let want = idx.map(|o| o.unwrap_or(usize::MAX));
+    let Some(last) = want.iter().copied().filter(|&o| o != usize::MAX).max() else {
+        return idx;
+    };
+    let mut map = idx;
+    let mut w = first_out;
+    for (i, st) in status.iter().enumerate().skip(first_out) {
+        if w > last {
+            break;
+        }
+        if *st == PointStatus::Kept {
+            for (m, &o) in map.iter_mut().zip(want.iter()) {
+                if o == w {
+                    *m = Some(i);
+                }
+            }
+            w += 1;
+        }
+    }
+    map
 }
 
 /// The status a kept point's `u8` in the working buffer stands for.

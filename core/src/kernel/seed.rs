@@ -47,6 +47,27 @@ pub(crate) struct Seeds {
     pub right: Option<usize>,
 }
 
+/// The read-only inputs of [`seed_candidates`].
+#[derive(Clone, Copy)]
+pub(crate) struct SeedArgs<'a> {
+    /// Smoothed x′ of the kept points.
+    pub x: &'a [f32],
+    /// Smoothed z′ of the kept points.
+    pub z: &'a [f32],
+    /// The smoothing gap squared (0: none).
+    pub gap2: f32,
+    /// ρ per kept point.
+    pub rho: &'a [f32],
+    /// k − s(k) per kept point.
+    pub s_off: &'a [u8],
+    /// τ_min, degrees.
+    pub tau_min: f32,
+    /// τ_max, degrees.
+    pub tau_max: f32,
+    /// The nadir, compact index.
+    pub nadir: Option<usize>,
+}
+
 /// Peak search over the smoothed kept points. `s_off[k]` = k − s(k) and, on entry,
 /// `aux[k]` = t(k) − k (from `bend::windows`); on return `aux[k]` holds the point's status
 /// as `u8` ([`PointStatus::Kept`] or
@@ -57,20 +78,24 @@ pub(crate) struct Seeds {
 /// the indices from where it stopped (or from s(k), starting afresh, when it stopped before
 /// s(k)) up to t(k). Both window ends only move forward, so every index enters at most
 /// once: O(n) in the worst case, and nearly nothing on plain road.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn seed_candidates(
-    x: &[f32],
-    z: &[f32],
-    gap2: f32,
-    rho: &[f32],
-    s_off: &[u8],
+///
+/// Without `STATUS` (a lean pass, see `Kernel::set_lean_rho`) `aux` is only read.
+pub(crate) fn seed_candidates<const STATUS: bool>(
+    args: SeedArgs<'_>,
     aux: &mut [u8],
-    tau_min: f32,
-    tau_max: f32,
-    nadir: Option<usize>,
     deque: &mut [u16; DEQUE_LEN],
 ) -> Seeds {
     const M: usize = DEQUE_LEN - 1;
+    let SeedArgs {
+        x,
+        z,
+        gap2,
+        rho,
+        s_off,
+        tau_min,
+        tau_max,
+        nadir,
+    } = args;
     let n = x.len();
     let (rho, s_off, aux) = (&rho[..n], &s_off[..n], &mut aux[..n]);
     let mut out = Seeds::default();
@@ -85,11 +110,15 @@ pub(crate) fn seed_candidates(
         // No neighbour on a side: rare (line ends, isolated points), so a branch rather
         // than a branch-free count.
         if s == k || t == k {
-            aux[k] = PointStatus::NoNeighbour as u8;
+            if STATUS {
+                aux[k] = PointStatus::NoNeighbour as u8;
+            }
             out.no_neighbour += 1;
             continue;
         }
-        aux[k] = PointStatus::Kept as u8;
+        if STATUS {
+            aux[k] = PointStatus::Kept as u8;
+        }
         let r = rho[k];
         if !(r > tau_min && r < tau_max) {
             continue;
@@ -163,18 +192,17 @@ mod tests {
         let mut s_off = [0u8; 32];
         windows(x, &z[..n], d2, &mut s_off[..n], &mut aux[..n]);
         let mut dq = [0u16; DEQUE_LEN];
-        let seeds = seed_candidates(
+        let args = SeedArgs {
             x,
-            &z[..n],
-            0.09,
+            z: &z[..n],
+            gap2: 0.09,
             rho,
-            &s_off[..n],
-            &mut aux[..n],
-            35.0,
-            150.0,
+            s_off: &s_off[..n],
+            tau_min: 35.0,
+            tau_max: 150.0,
             nadir,
-            &mut dq,
-        );
+        };
+        let seeds = seed_candidates::<true>(args, &mut aux[..n], &mut dq);
         (seeds, aux)
     }
 

@@ -360,17 +360,19 @@ pub(crate) fn taubin_smooth(
     let mut start = 0;
     while start < n {
         let end = if split {
-            // Pairs of consecutive points as slice windows: the M4F walks two pointers
-            // instead of indexing four values per point.
-            let pairs = x[start..].windows(2).zip(z[start..].windows(2));
-            start
-                + 1
-                + pairs
-                    .take_while(|(px, pz)| {
-                        let (dx, dz) = (px[1] - px[0], pz[1] - pz[0]);
-                        !(dx * dx + dz * dz > gap2)
-                    })
-                    .count()
+            // The previous point stays in registers: two loads per point.
+            let (mut px, mut pz) = (x[start], z[start]);
+            let mut e = start + 1;
+            while e < n {
+                let (cx, cz) = (x[e], z[e]);
+                let (dx, dz) = (cx - px, cz - pz);
+                if dx * dx + dz * dz > gap2 {
+                    break;
+                }
+                (px, pz) = (cx, cz);
+                e += 1;
+            }
+            e
         } else {
             n
         };

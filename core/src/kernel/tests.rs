@@ -702,12 +702,13 @@ fn stage_timings() {
     std::println!("windows (smoothed line): {r:.1?} ns/pt");
     let mut rho = std::vec![0f32; n];
     let r = min_med(n, 2000, || {
-        bend::bend_angles::<crate::math::Selected>(
+        bend::bend_angles::<crate::math::Selected, false>(
             core::hint::black_box(&x),
             &z,
             &s_off,
             &t_off,
             &mut rho,
+            bend::LowCut::NONE,
         )
     });
     std::println!("bend_angles: {r:.1?} ns/pt");
@@ -873,4 +874,72 @@ fn a_region_holding_every_point_changes_nothing() {
     assert_eq!(oa.status, ob.status);
     assert_eq!(oa.rho_deg, ob.rho_deg);
     assert_ne!(oa.params_hash, ob.params_hash);
+}
+
+/// The lean pass changes nothing a candidates packet carries (nadir, candidates and
+/// their values, every count), skips the arctangent on most points, and is off in points
+/// mode; with and without a region of interest.
+#[test]
+fn lean_pass_keeps_the_candidates_packet() {
+    let candidates = KernelParams {
+        output_mode: 1,
+        ..KernelParams::DEFAULT
+    };
+    let roi = KernelParams {
+        roi_x_min_m: -6.0,
+        roi_x_max_m: 3.5,
+        roi_z_min_m: -2.5,
+        roi_z_max_m: -1.7,
+        ..candidates
+    };
+    let points = KernelParams {
+        output_mode: 0,
+        ..roi
+    };
+    let mut skipped = 0usize;
+    for (params, lean_applies) in [(candidates, true), (roi, true), (points, false)] {
+        for seed in 0..16u64 {
+            let mut buf = std::vec![(0f32, 0f32, 0u32); N];
+            let n = Scene::DEFAULT.generate(&mut Rng(seed), &mut buf);
+            // A spike and a non-finite point, so the kept points' partition moves points
+            // (a region may hold them outside).
+            buf[n / 3].1 += 0.1;
+            buf[n / 2].0 = f32::NAN;
+            let mut full = Kernel::<N>::new(params);
+            let mut lean = Kernel::<N>::new(params);
+            lean.set_lean_rho(true);
+            let (mut la, mut lb) = (line_from(&buf[..n]), line_from(&buf[..n]));
+            let (a, b) = (full.process(&mut la), lean.process(&mut lb));
+            let set_aside = a.counters.irregular + a.counters.non_finite;
+            assert!(set_aside >= 2 || params.roi().is_some(), "seed {seed}");
+            assert_eq!(a.counters, b.counters, "seed {seed}");
+            assert_eq!((a.nadir, a.left, a.right), (b.nadir, b.left, b.right));
+            assert!(a.left.is_some() && a.right.is_some(), "seed {seed}");
+            for k in [a.nadir, a.left, a.right].into_iter().flatten() {
+                let k = usize::from(k);
+                let at = |o: &ScanlineOutput<'_>| {
+                    (
+                        o.tag[k],
+                        o.x_m[k].to_bits(),
+                        o.z_m[k].to_bits(),
+                        o.rho_deg[k].to_bits(),
+                        o.status[k],
+                    )
+                };
+                assert_eq!(at(&a), at(&b), "seed {seed} point {k}");
+            }
+            if !lean_applies {
+                let bits = |v: &[f32]| v.iter().map(|f| f.to_bits()).collect::<Vec<u32>>();
+                assert_eq!(bits(a.rho_deg), bits(b.rho_deg));
+                assert_eq!(bits(a.x_m), bits(b.x_m));
+                assert_eq!(a.status, b.status);
+            }
+            skipped += b
+                .rho_deg
+                .iter()
+                .filter(|&&r| r == params.tau_min_deg)
+                .count();
+        }
+    }
+    assert!(skipped > 16 * 1000, "{skipped}");
 }
