@@ -95,9 +95,9 @@ pub struct BendParams {
     /// virtual profile, so that a ramp (behind a curb cut) is not taken for a step. Not in
     /// the paper; 10 % is above road cross slopes and sidewalk falls.
     pub profile_max_slope: f64,
-    /// How far from the trajectory, metres, a side that the core's candidates give no seed
-    /// in an interval is searched for a curb toe on virtual profiles across the driving
-    /// direction (`seed::profile_seeds`; 0 = never). Not in the paper: where a scanline
+    /// How far from the trajectory, metres, each interval's sides are searched for a curb
+    /// toe on virtual profiles across the driving direction, which seed tracks besides the
+    /// core's candidates (`seed::profile_seeds`; 0 = never). Not in the paper: where a scanline
     /// meets a curb at a grazing angle in plan (a yawed mount, far from the scanner) it
     /// climbs the face over a metre or more and its bend angle never peaks, while the step
     /// is there between the scanlines. 15 m reaches the far curb of a 14 m road from the

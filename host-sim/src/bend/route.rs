@@ -87,7 +87,11 @@ impl Route {
         if n == 0 || !s.is_finite() {
             return None;
         }
-        let k = self.s.partition_point(|&u| u <= s).clamp(1, n.max(2) - 1).min(n - 1);
+        let k = self
+            .s
+            .partition_point(|&u| u <= s)
+            .clamp(1, n.max(2) - 1)
+            .min(n - 1);
         let j = k.saturating_sub(1);
         let (a, b) = (self.s[j], self.s[k]);
         let w = if b > a {

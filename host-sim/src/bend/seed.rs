@@ -95,8 +95,7 @@ const PROFILE_SEED_NEAR_M: f64 = 1.0;
 /// steps leave no stretch unseen.
 const PROFILE_SEED_STEP_M: f64 = 0.5;
 
-/// Seeds from virtual profiles (`profile::profile_toe`) for every interval and side that
-/// `kernel_seeds` (the seeds from the core's candidates) leave without one.
+/// Seeds from virtual profiles (`profile::profile_toe`), one per interval and side at most.
 ///
 /// At the middle of each interval of L_s along the route, profiles across the driving
 /// direction are tried outward from [`PROFILE_SEED_NEAR_M`] to `profile_seed_reach_m`
@@ -105,7 +104,8 @@ const PROFILE_SEED_STEP_M: f64 = 0.5;
 /// profiles are centred on the height of the ground there (the median of the points within
 /// the profile's half-width), so a road's crossfall does not push the curb out of their
 /// height band. These seeds come last in tracking (inlier share 0): they start tracks only
-/// on curbs no seed of the core's candidates has reached.
+/// on curbs no seed of the core's candidates has reached — also in intervals that have
+/// such a seed, whose track may lie on something else or end before the interval does.
 ///
 /// Only the interval range the input's points cover is searched, so a streaming window
 /// seeds its own stretch.
@@ -113,7 +113,6 @@ pub fn profile_seeds(
     input: &BendInput,
     grid: &PointGrid,
     route: &Route,
-    kernel_seeds: &[Seed],
     params: &BendParams,
 ) -> Vec<Seed> {
     let reach = params.profile_seed_reach_m;
@@ -122,18 +121,13 @@ pub fn profile_seeds(
         return out;
     }
     let finite_t = || input.t.iter().copied().filter(|t| t.is_finite());
-    let (Some(t0), Some(t1)) = (
-        finite_t().reduce(f64::min),
-        finite_t().reduce(f64::max),
-    ) else {
+    let (Some(t0), Some(t1)) = (finite_t().reduce(f64::min), finite_t().reduce(f64::max)) else {
         return out;
     };
     let (Some(s0), Some(s1)) = (route.arc_at(t0), route.arc_at(t1)) else {
         return out;
     };
     let l_s = params.seed_interval_m.max(1e-3);
-    let seeded: std::collections::HashSet<(Side, i64)> =
-        kernel_seeds.iter().map(|s| (s.side, s.interval)).collect();
     let half_l = 2.0 * params.profile_half_length_m;
     for interval in (s0 / l_s).floor() as i64..=(s1 / l_s).floor() as i64 {
         let mid = (interval as f64 + 0.5) * l_s;
@@ -144,9 +138,6 @@ pub fn profile_seeds(
             continue;
         };
         for (side, up) in [(Side::Left, 1.0), (Side::Right, -1.0)] {
-            if seeded.contains(&(side, interval)) {
-                continue;
-            }
             let n = [-fwd[1] * up, fwd[0] * up];
             let mut c = PROFILE_SEED_NEAR_M;
             while c <= reach {
@@ -160,8 +151,7 @@ pub fn profile_seeds(
                 let Some(toe) = profile_toe(input, grid, at, fwd, up, half_l, params) else {
                     continue;
                 };
-                if let Some(point) = nearest_usable(input, grid, toe.xyz, params.search_radius_m)
-                {
+                if let Some(point) = nearest_usable(input, grid, toe.xyz, params.search_radius_m) {
                     out.push(Seed {
                         point,
                         side,
