@@ -117,7 +117,7 @@ pub fn profile_seeds(
 ) -> Vec<Seed> {
     let reach = params.profile_seed_reach_m;
     let mut out = Vec::new();
-    if !(reach >= PROFILE_SEED_NEAR_M) {
+    if reach.is_nan() || reach < PROFILE_SEED_NEAR_M {
         return out;
     }
     let finite_t = || input.t.iter().copied().filter(|t| t.is_finite());
