@@ -109,6 +109,8 @@ pub fn extract_edges_on_route(
     let cell_m = params.search_radius_m.clamp(0.05, 1.0);
     let grid = grid::PointGrid::build(input.x, input.y, cell_m, |i| input.status[i].is_some());
     let mut seeds = seed::seed_points(&input, route, params);
+    let from_profiles = seed::profile_seeds(&input, &grid, route, params);
+    seeds.extend(from_profiles);
     // Best-fitting seeds first: the first track along a curb claims it, later seeds on the
     // same curb start nothing.
     seeds.sort_by(|a, b| {

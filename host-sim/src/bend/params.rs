@@ -95,6 +95,14 @@ pub struct BendParams {
     /// virtual profile, so that a ramp (behind a curb cut) is not taken for a step. Not in
     /// the paper; 10 % is above road cross slopes and sidewalk falls.
     pub profile_max_slope: f64,
+    /// How far from the trajectory, metres, each interval's sides are searched for a curb
+    /// toe on virtual profiles across the driving direction, which seed tracks besides the
+    /// core's candidates (`seed::profile_seeds`; 0 = never). Not in the paper: where a scanline
+    /// meets a curb at a grazing angle in plan (a yawed mount, far from the scanner) it
+    /// climbs the face over a metre or more and its bend angle never peaks, while the step
+    /// is there between the scanlines. 15 m reaches the far curb of a 14 m road from the
+    /// near lane.
+    pub profile_seed_reach_m: f64,
     /// Upper bound of steps per track (per direction): a safety net only.
     pub max_steps: u32,
     /// Distance, metres, within which a track is taken to have reached another track (it
@@ -195,6 +203,7 @@ impl Default for BendParams {
             profile_half_length_m: 0.15,
             profile_min_step_m: 0.05,
             profile_max_slope: 0.1,
+            profile_seed_reach_m: 15.0,
             max_steps: 200_000,
             join_distance_m: 0.05,
             bridge_max_m: 12.0,

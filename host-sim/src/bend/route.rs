@@ -80,6 +80,33 @@ impl Route {
         Some(self.s[k] + (self.s[next] - self.s[k]) * w)
     }
 
+    /// Horizontal position and forward unit vector where the route's arc length is `s`
+    /// metres (clamped to the covered range).
+    pub fn pose_at_arc(&self, s: f64) -> Option<([f64; 2], [f64; 2])> {
+        let n = self.s.len();
+        if n == 0 || !s.is_finite() {
+            return None;
+        }
+        let k = self
+            .s
+            .partition_point(|&u| u <= s)
+            .clamp(1, n.max(2) - 1)
+            .min(n - 1);
+        let j = k.saturating_sub(1);
+        let (a, b) = (self.s[j], self.s[k]);
+        let w = if b > a {
+            ((s - a) / (b - a)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let p = [
+            self.x[j] + (self.x[k] - self.x[j]) * w,
+            self.y[j] + (self.y[k] - self.y[j]) * w,
+        ];
+        let t = self.t[j] + (self.t[k] - self.t[j]) * w;
+        Some((p, self.forward_at(t)?))
+    }
+
     /// Horizontal forward unit vector at time `t` (from the heading, docs/spec.md §2).
     pub fn forward_at(&self, t: f64) -> Option<[f64; 2]> {
         let (k, w) = self.bracket(t)?;

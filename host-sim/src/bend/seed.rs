@@ -9,7 +9,9 @@ use rand::Rng;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
+use super::grid::PointGrid;
 use super::params::BendParams;
+use super::profile::{profile_toe, usable};
 use super::route::Route;
 use super::BendInput;
 use crate::model::Side;
@@ -82,6 +84,118 @@ pub fn seed_points(input: &BendInput, route: &Route, params: &BendParams) -> Vec
         start = end;
     }
     seeds
+}
+
+/// Nearest distance from the trajectory at which [`profile_seeds`] looks for a toe, metres:
+/// inside it lie the vehicle's own lane and the returns its body leaves out.
+const PROFILE_SEED_NEAR_M: f64 = 1.0;
+
+/// Step between the profiles [`profile_seeds`] tries outward, metres: a profile finds a toe
+/// within 0.3 m of its centre (`profile_half_width_m` less the 0.15 m kept clear), so 0.5 m
+/// steps leave no stretch unseen.
+const PROFILE_SEED_STEP_M: f64 = 0.5;
+
+/// Seeds from virtual profiles (`profile::profile_toe`), one per interval and side at most.
+///
+/// At the middle of each interval of L_s along the route, profiles across the driving
+/// direction are tried outward from [`PROFILE_SEED_NEAR_M`] to `profile_seed_reach_m`
+/// every [`PROFILE_SEED_STEP_M`]; the first toe found, as the core's candidate is the
+/// first peak outward from the nadir, gives a seed on the point nearest to it. The
+/// profiles are centred on the height of the ground there (the median of the points within
+/// the profile's half-width), so a road's crossfall does not push the curb out of their
+/// height band. These seeds come last in tracking (inlier share 0): they start tracks only
+/// on curbs no seed of the core's candidates has reached — also in intervals that have
+/// such a seed, whose track may lie on something else or end before the interval does.
+///
+/// Only the interval range the input's points cover is searched, so a streaming window
+/// seeds its own stretch.
+pub fn profile_seeds(
+    input: &BendInput,
+    grid: &PointGrid,
+    route: &Route,
+    params: &BendParams,
+) -> Vec<Seed> {
+    let reach = params.profile_seed_reach_m;
+    let mut out = Vec::new();
+    if reach.is_nan() || reach < PROFILE_SEED_NEAR_M {
+        return out;
+    }
+    let finite_t = || input.t.iter().copied().filter(|t| t.is_finite());
+    let (Some(t0), Some(t1)) = (finite_t().reduce(f64::min), finite_t().reduce(f64::max)) else {
+        return out;
+    };
+    let (Some(s0), Some(s1)) = (route.arc_at(t0), route.arc_at(t1)) else {
+        return out;
+    };
+    let l_s = params.seed_interval_m.max(1e-3);
+    let half_l = 2.0 * params.profile_half_length_m;
+    for interval in (s0 / l_s).floor() as i64..=(s1 / l_s).floor() as i64 {
+        let mid = (interval as f64 + 0.5) * l_s;
+        if mid < s0 || mid > s1 {
+            continue;
+        }
+        let Some((p, fwd)) = route.pose_at_arc(mid) else {
+            continue;
+        };
+        for (side, up) in [(Side::Left, 1.0), (Side::Right, -1.0)] {
+            let n = [-fwd[1] * up, fwd[0] * up];
+            let mut c = PROFILE_SEED_NEAR_M;
+            while c <= reach {
+                let centre = [p[0] + c * n[0], p[1] + c * n[1]];
+                c += PROFILE_SEED_STEP_M;
+                let Some(z) = ground_height(input, grid, centre, params.profile_half_width_m)
+                else {
+                    continue;
+                };
+                let at = [centre[0], centre[1], z];
+                let Some(toe) = profile_toe(input, grid, at, fwd, up, half_l, params) else {
+                    continue;
+                };
+                if let Some(point) = nearest_usable(input, grid, toe.xyz, params.search_radius_m) {
+                    out.push(Seed {
+                        point,
+                        side,
+                        dir: fwd,
+                        interval,
+                        inlier_ratio: 0.0,
+                    });
+                }
+                break;
+            }
+        }
+    }
+    out
+}
+
+/// Median height of the usable points within `r` (horizontal) of `centre`; `None` with
+/// fewer than 8 of them.
+fn ground_height(input: &BendInput, grid: &PointGrid, centre: [f64; 2], r: f64) -> Option<f64> {
+    let mut z: Vec<f64> = Vec::new();
+    grid.for_each_within(input.x, input.y, centre[0], centre[1], r, |i| {
+        if usable(input, i) && input.z[i].is_finite() {
+            z.push(input.z[i]);
+        }
+    });
+    if z.len() < 8 {
+        return None;
+    }
+    let k = z.len() / 2;
+    Some(*z.select_nth_unstable_by(k, f64::total_cmp).1)
+}
+
+/// The usable point nearest (horizontally) to `at` within `r`, lowest index on ties.
+fn nearest_usable(input: &BendInput, grid: &PointGrid, at: [f64; 3], r: f64) -> Option<u32> {
+    let mut best: Option<(f64, usize)> = None;
+    grid.for_each_within(input.x, input.y, at[0], at[1], r, |i| {
+        if !usable(input, i) {
+            return;
+        }
+        let d = (input.x[i] - at[0]).hypot(input.y[i] - at[1]);
+        if best.is_none_or(|(bd, bi)| d < bd || (d == bd && i < bi)) {
+            best = Some((d, i));
+        }
+    });
+    best.map(|(_, i)| i as u32)
 }
 
 /// A RANSAC line fit.

@@ -69,7 +69,8 @@ pub fn track_edges(
 
     for seed in seeds {
         let s = seed.point as usize;
-        if s >= input.x.len() || input.status.get(s) != Some(&Some(PointStatus::Kept)) {
+        // A seed from a virtual profile may sit on a point without a bend angle.
+        if s >= input.x.len() || !usable(input, s) {
             continue;
         }
         let id = tracks.len();
