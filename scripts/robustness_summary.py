@@ -162,7 +162,8 @@ def main():
     for name, v, t in targets:
         op, bound = t.split()
         ok = v is not None and (v >= float(bound) if op == ">=" else v <= float(bound))
-        p(f"| {name} | {fmt(v)} | {t.replace('>=', '≥').replace('<=', '≤')} | {'yes' if ok else 'no'} |")
+        met = "not run" if v is None else ("yes" if ok else "no")
+        p(f"| {name} | {fmt(v)} | {t.replace('>=', '≥').replace('<=', '≤')} | {met} |")
     p()
     p("## bend, 50 mm buffer")
     p()
