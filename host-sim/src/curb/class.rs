@@ -243,7 +243,12 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
 /// curb cut and its transitions, or a cut and its curb, sit on different edges.
 pub fn settle_runs(edges: &mut [EdgeLine]) {
     let n = edges.len();
-    let ok = |e: &EdgeLine| e.detail.as_ref().is_some_and(|d| d.class.len() == e.points.len()) && !e.points.is_empty();
+    let ok = |e: &EdgeLine| {
+        e.detail
+            .as_ref()
+            .is_some_and(|d| d.class.len() == e.points.len())
+            && !e.points.is_empty()
+    };
     // next[i]: the edge whose start continues edge i's end (the nearest, each start once).
     let mut next: Vec<Option<usize>> = vec![None; n];
     let mut has_prev = vec![false; n];
@@ -254,7 +259,12 @@ pub fn settle_runs(edges: &mut [EdgeLine]) {
         let p = edges[i].points[edges[i].points.len() - 1];
         let best = (0..n)
             .filter(|&j| j != i && !has_prev[j] && ok(&edges[j]) && edges[j].side == edges[i].side)
-            .map(|j| (j, (edges[j].points[0][0] - p[0]).hypot(edges[j].points[0][1] - p[1])))
+            .map(|j| {
+                (
+                    j,
+                    (edges[j].points[0][0] - p[0]).hypot(edges[j].points[0][1] - p[1]),
+                )
+            })
             .filter(|&(_, d)| d <= END_JOIN_M)
             .min_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((j, _)) = best {
@@ -283,7 +293,9 @@ pub fn settle_runs(edges: &mut [EdgeLine]) {
         let mut d = CurbDetail::default();
         for &k in &chain {
             let e = &edges[k];
-            let Some(ed) = e.detail.as_ref() else { continue };
+            let Some(ed) = e.detail.as_ref() else {
+                continue;
+            };
             pts.extend_from_slice(&e.points);
             d.class.extend_from_slice(&ed.class);
             let mut h = ed.height_m.clone();
@@ -557,5 +569,71 @@ mod tests {
         assert_eq!(d.class[10], Category::Flush);
         assert_eq!(d.class[320], Category::CurbCut);
         assert_eq!(d.class[260], Category::Curb);
+    }
+
+    #[test]
+    fn a_curb_cut_takes_its_transition_on_the_edge_before_it() {
+        // Edge A: 5 m of 0.15 m curb whose last 0.5 m falls to 0.06 m (a transition, no
+        // vertex below CUT_MAX_M); edge B starts where A ends: a 3 m cut at 0.02 m, then
+        // 3 m of curb. Alone, A is curb to its end (no cut on it to grow); as one line the
+        // cut takes A's transition.
+        let line = |x0: f64, n: usize, h: &dyn Fn(usize) -> f64| {
+            let p: Vec<[f64; 3]> = (0..n).map(|i| [x0 + i as f64 * 0.1, 0.0, 0.0]).collect();
+            let mut d = CurbDetail::measured(&p);
+            d.height_m = (0..n).map(h).collect();
+            d.class = d
+                .height_m
+                .iter()
+                .map(|&h| {
+                    if h < CUT_MAX_M {
+                        Category::CurbCut
+                    } else {
+                        Category::Curb
+                    }
+                })
+                .collect();
+            EdgeLine {
+                points: p,
+                side: Side::Left,
+                category: None,
+                method: None,
+                curb_height_m: None,
+                detail: Some(Box::new(d)),
+            }
+        };
+        let a = line(0.0, 51, &|i| {
+            if i < 45 {
+                0.15
+            } else {
+                0.15 - 0.015 * (i - 44) as f64
+            }
+        });
+        let b = line(5.0, 61, &|i| if i <= 30 { 0.02 } else { 0.15 });
+        let mut alone = vec![a.clone()];
+        settle_runs(&mut alone);
+        assert!(alone[0]
+            .detail
+            .as_ref()
+            .unwrap()
+            .class
+            .iter()
+            .all(|&c| c == Category::Curb));
+        // Given in the other order: the chain follows the ends, not the list.
+        let mut both = vec![b, a];
+        settle_runs(&mut both);
+        let ca = &both[1].detail.as_ref().unwrap().class;
+        let cb = &both[0].detail.as_ref().unwrap().class;
+        // A's transition below 0.14 m (vertices 45..=50) joins the cut, the rest is curb.
+        for (k, &c) in ca.iter().enumerate() {
+            let want = if k >= 45 {
+                Category::CurbCut
+            } else {
+                Category::Curb
+            };
+            assert_eq!(c, want, "A vertex {k}");
+        }
+        assert_eq!(cb[0], Category::CurbCut);
+        assert_eq!(cb[30], Category::CurbCut);
+        assert_eq!(cb[45], Category::Curb);
     }
 }
