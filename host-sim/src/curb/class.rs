@@ -235,6 +235,89 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
     }
 }
 
+/// The run rules on closed edges ([`grow_cuts`], [`flush_runs`], then the smoothing of
+/// [`smoothed_runs`] to stretches of at least [`MIN_RUN_M`]), leaving each vertex's class
+/// the class of its stretch. Edges that continue one another (the end of one within
+/// [`END_JOIN_M`] of the start of the next, on the same side) are one line for these rules:
+/// the tracker often ends a track where the curb drops and starts the next one there, so a
+/// curb cut and its transitions, or a cut and its curb, sit on different edges.
+pub fn settle_runs(edges: &mut [EdgeLine]) {
+    let n = edges.len();
+    let ok = |e: &EdgeLine| {
+        e.detail
+            .as_ref()
+            .is_some_and(|d| d.class.len() == e.points.len())
+            && !e.points.is_empty()
+    };
+    // next[i]: the edge whose start continues edge i's end (the nearest, each start once).
+    let mut next: Vec<Option<usize>> = vec![None; n];
+    let mut has_prev = vec![false; n];
+    for i in 0..n {
+        if !ok(&edges[i]) {
+            continue;
+        }
+        let p = edges[i].points[edges[i].points.len() - 1];
+        let best = (0..n)
+            .filter(|&j| j != i && !has_prev[j] && ok(&edges[j]) && edges[j].side == edges[i].side)
+            .map(|j| {
+                (
+                    j,
+                    (edges[j].points[0][0] - p[0]).hypot(edges[j].points[0][1] - p[1]),
+                )
+            })
+            .filter(|&(_, d)| d <= END_JOIN_M)
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((j, _)) = best {
+            next[i] = Some(j);
+            has_prev[j] = true;
+        }
+    }
+    let mut done = vec![false; n];
+    // Chains from their first edge, then what is left (closed loops) from any edge.
+    let starts: Vec<usize> = (0..n).filter(|&i| !has_prev[i]).chain(0..n).collect();
+    for i0 in starts {
+        if done[i0] || !ok(&edges[i0]) {
+            continue;
+        }
+        let mut chain = Vec::new();
+        let mut i = Some(i0);
+        while let Some(k) = i {
+            if done[k] {
+                break;
+            }
+            done[k] = true;
+            chain.push(k);
+            i = next[k];
+        }
+        let mut pts: Vec<[f64; 3]> = Vec::new();
+        let mut d = CurbDetail::default();
+        for &k in &chain {
+            let e = &edges[k];
+            let Some(ed) = e.detail.as_ref() else {
+                continue;
+            };
+            pts.extend_from_slice(&e.points);
+            d.class.extend_from_slice(&ed.class);
+            let mut h = ed.height_m.clone();
+            h.resize(e.points.len(), 0.0);
+            d.height_m.extend(h);
+        }
+        grow_cuts(&pts, &mut d);
+        flush_runs(&pts, &mut d);
+        for (a, b, cat) in smoothed_runs(&pts, &d.class, MIN_RUN_M) {
+            d.class[a..=b].fill(cat);
+        }
+        let mut at = 0;
+        for &k in &chain {
+            let m = edges[k].points.len();
+            if let Some(ed) = edges[k].detail.as_mut() {
+                ed.class.copy_from_slice(&d.class[at..at + m]);
+            }
+            at += m;
+        }
+    }
+}
+
 /// Extends every intersection run over the vertices beside it that still turn more than
 /// [`TURN_GROW_DEG`] from the route (the start of a corner arc).
 fn grow_intersections(angle: &[f64], class: &mut [Category]) {
@@ -486,5 +569,71 @@ mod tests {
         assert_eq!(d.class[10], Category::Flush);
         assert_eq!(d.class[320], Category::CurbCut);
         assert_eq!(d.class[260], Category::Curb);
+    }
+
+    #[test]
+    fn a_curb_cut_takes_its_transition_on_the_edge_before_it() {
+        // Edge A: 5 m of 0.15 m curb whose last 0.5 m falls to 0.06 m (a transition, no
+        // vertex below CUT_MAX_M); edge B starts where A ends: a 3 m cut at 0.02 m, then
+        // 3 m of curb. Alone, A is curb to its end (no cut on it to grow); as one line the
+        // cut takes A's transition.
+        let line = |x0: f64, n: usize, h: &dyn Fn(usize) -> f64| {
+            let p: Vec<[f64; 3]> = (0..n).map(|i| [x0 + i as f64 * 0.1, 0.0, 0.0]).collect();
+            let mut d = CurbDetail::measured(&p);
+            d.height_m = (0..n).map(h).collect();
+            d.class = d
+                .height_m
+                .iter()
+                .map(|&h| {
+                    if h < CUT_MAX_M {
+                        Category::CurbCut
+                    } else {
+                        Category::Curb
+                    }
+                })
+                .collect();
+            EdgeLine {
+                points: p,
+                side: Side::Left,
+                category: None,
+                method: None,
+                curb_height_m: None,
+                detail: Some(Box::new(d)),
+            }
+        };
+        let a = line(0.0, 51, &|i| {
+            if i < 45 {
+                0.15
+            } else {
+                0.15 - 0.015 * (i - 44) as f64
+            }
+        });
+        let b = line(5.0, 61, &|i| if i <= 30 { 0.02 } else { 0.15 });
+        let mut alone = vec![a.clone()];
+        settle_runs(&mut alone);
+        assert!(alone[0]
+            .detail
+            .as_ref()
+            .unwrap()
+            .class
+            .iter()
+            .all(|&c| c == Category::Curb));
+        // Given in the other order: the chain follows the ends, not the list.
+        let mut both = vec![b, a];
+        settle_runs(&mut both);
+        let ca = &both[1].detail.as_ref().unwrap().class;
+        let cb = &both[0].detail.as_ref().unwrap().class;
+        // A's transition below 0.14 m (vertices 45..=50) joins the cut, the rest is curb.
+        for (k, &c) in ca.iter().enumerate() {
+            let want = if k >= 45 {
+                Category::CurbCut
+            } else {
+                Category::Curb
+            };
+            assert_eq!(c, want, "A vertex {k}");
+        }
+        assert_eq!(cb[0], Category::CurbCut);
+        assert_eq!(cb[30], Category::CurbCut);
+        assert_eq!(cb[45], Category::Curb);
     }
 }

@@ -220,19 +220,25 @@ pub fn median(v: &mut [f64]) -> Option<f64> {
 /// Cuts closed edges into stretches of one class and one kind of support, with their
 /// height (median over the stretch), support and bridged flag. Edges without detail (the
 /// plane method's) pass unchanged.
-pub fn finish(edges: Vec<EdgeLine>) -> Vec<EdgeLine> {
+pub fn finish(mut edges: Vec<EdgeLine>) -> Vec<EdgeLine> {
+    for e in edges.iter_mut() {
+        let (n, cat) = (e.points.len(), e.category.unwrap_or(Category::Curb));
+        if let Some(d) = e.detail.as_mut() {
+            if d.class.len() != n {
+                d.class = vec![cat; n];
+            }
+        }
+    }
+    class::settle_runs(&mut edges);
     let mut out = Vec::with_capacity(edges.len());
-    for mut e in edges {
-        let Some(d) = e.detail.as_mut() else {
+    for e in edges {
+        let Some(d) = e.detail.as_ref() else {
             out.push(e);
             continue;
         };
-        if d.class.len() != e.points.len() {
-            d.class = vec![e.category.unwrap_or(Category::Curb); e.points.len()];
-        }
-        class::grow_cuts(&e.points, d);
-        class::flush_runs(&e.points, d);
-        let class = class::smoothed_runs(&e.points, &d.class, class::MIN_RUN_M);
+        // The classes are settled: every run here is a stretch (or the part of one that
+        // lies on this edge).
+        let class = class::smoothed_runs(&e.points, &d.class, 0.0);
         let measured = d.measured.clone();
         for (a, b, cat) in class {
             for (ra, rb, bridged) in bridged_runs(&e.points[a..=b], &measured[a..=b]) {
