@@ -8,6 +8,7 @@ on stdout and draws the worst place of the worst streets with `BIN eval --pictur
 docs/robustness/.
 """
 import json
+import os
 import re
 import subprocess
 import sys
@@ -130,7 +131,9 @@ def main():
     p(f"{first}–{first + n - 1} are kept apart from the tuning seeds 1–100. Produced by")
     p()
     p("```sh")
-    p(f"scripts/robustness.sh {n} {first}")
+    methods = os.environ.get("METHODS", "bend qiu")
+    prefix = "" if methods.split() == ["bend", "qiu"] else f'ROBUSTNESS_METHODS="{methods}" '
+    p(f"{prefix}scripts/robustness.sh {n} {first}")
     p("```")
     p()
     p(f"({n_all} streets, {elapsed} s wall on the shared 2-core build machine, two streets at a time;")
@@ -217,6 +220,10 @@ def main():
     p()
     p("## qiu, 200 mm buffer")
     p()
+    if not qiu:
+        p("qiu was not run for this page (`ROBUSTNESS_METHODS`); its figures on these seeds are in")
+        p("the page's git history, from the last run that included it.")
+        p()
     p("| [%] | streets | min | 10th pct | median | mean |")
     p("|---|---:|---:|---:|---:|---:|")
     p(dist_row("completeness", [s["qiu"]["total"]["completeness"] for s in qiu], n_all))
