@@ -855,12 +855,18 @@ mod tests {
                     // Finite points in range only: the sweep's nadir is `seed::nadir`'s.
                     assert_eq!(nd, Some(super::super::seed::nadir(&x[..n], &z[..n])));
                 }
+                // A skipped point's exact angle is below 29°; the backend's own ρ of it
+                // is within the arctangent's error of that (micromath 0.162°).
+                let below = match crate::math::BACKEND {
+                    crate::math::Backend::Micromath => 29.0 + 0.162,
+                    _ => 29.0,
+                };
                 for i in 0..n {
                     let (a, b, c) = (rho1[i], rho5[i], rho6[i]);
                     assert!(b.to_bits() == c.to_bits() || (b.is_nan() && c.is_nan()));
                     let same = a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
                     assert!(
-                        same || (b == 30.0 && a < 29.0),
+                        same || (b == 30.0 && a < below),
                         "case {case} d2 {d2} i {i}: {a} {b}"
                     );
                 }
