@@ -343,6 +343,29 @@ fn straight_road_gives_one_edge_per_side_on_the_toes() {
     }
 }
 
+/// A curb the core gave no candidate for (a far curb crossed at a grazing angle, or returns
+/// sparser than d_b) is still found: the profile seeds start its track from the height
+/// step across the scanlines. Without them that side has no edge.
+#[test]
+fn a_curb_without_candidates_is_seeded_from_profiles() {
+    let mut sc = make_scene(&straight(3));
+    sc.candidates.retain(|c| c.side == Side::Right);
+    let off = BendParams {
+        profile_seed_reach_m: 0.0,
+        ..BendParams::default()
+    };
+    let without = extract_edges(&sc.input(), &off);
+    assert_eq!(side_length(&without, Side::Left), 0.0, "{without:#?}");
+    let with = extract_edges(&sc.input(), &BendParams::default());
+    let l = side_length(&with, Side::Left);
+    assert!(l > 25.0, "left edge {l:.2} m of 29.81 m");
+    for e in with.iter().filter(|e| e.side == Side::Left) {
+        for &p in &e.points {
+            assert!(dist_to_toe(&sc, Side::Left, p) < 0.05, "{p:?} off the toe");
+        }
+    }
+}
+
 #[test]
 fn output_is_deterministic() {
     let sc = make_scene(&straight(2));
