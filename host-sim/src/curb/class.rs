@@ -478,6 +478,19 @@ mod tests {
         (0..n).map(|i| [i as f64 * step, 0.0, 0.0]).collect()
     }
 
+    /// The first classes of a height profile: curb cut below `CUT_MAX_M`, curb above.
+    fn by_height(h: &[f64]) -> Vec<Category> {
+        h.iter()
+            .map(|&h| {
+                if h < CUT_MAX_M {
+                    Category::CurbCut
+                } else {
+                    Category::Curb
+                }
+            })
+            .collect()
+    }
+
     #[test]
     fn short_runs_join_their_neighbours_and_runs_cover_every_vertex() {
         let p = pts(101, 0.1);
@@ -503,17 +516,7 @@ mod tests {
             let f = (1.0 - x / 10.0).clamp(0.0, 1.0);
             *h = 0.15 - (0.15 - 0.02) * f;
         }
-        d.class = d
-            .height_m
-            .iter()
-            .map(|&h| {
-                if h < CUT_MAX_M {
-                    Category::CurbCut
-                } else {
-                    Category::Curb
-                }
-            })
-            .collect();
+        d.class = by_height(&d.height_m);
         assert_eq!(d.class[26], Category::Curb, "0.059 m before growing");
         grow_cuts(&p, &mut d);
         // The transitions' vertices below 0.15 − max(5 % of 0.15, 1 cm) = 0.14 m join the
@@ -581,17 +584,7 @@ mod tests {
             let p: Vec<[f64; 3]> = (0..n).map(|i| [x0 + i as f64 * 0.1, 0.0, 0.0]).collect();
             let mut d = CurbDetail::measured(&p);
             d.height_m = (0..n).map(h).collect();
-            d.class = d
-                .height_m
-                .iter()
-                .map(|&h| {
-                    if h < CUT_MAX_M {
-                        Category::CurbCut
-                    } else {
-                        Category::Curb
-                    }
-                })
-                .collect();
+            d.class = by_height(&d.height_m);
             EdgeLine {
                 points: p,
                 side: Side::Left,
