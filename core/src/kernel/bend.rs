@@ -240,18 +240,31 @@ fn left_neighbour(x: &[f32], z: &[f32], d2: f32, s_prev: usize, i: usize) -> usi
 pub(crate) struct Threshold {
     cos: f32,
     sin: f32,
+    /// A d at least this large is certainly not irregular (see [`irregular_test`]): 0 when
+    /// cos ≤ 0 ≤ sin (a threshold of 90° or more), else +∞.
+    d_kept: f32,
 }
 
 impl Threshold {
     /// A placeholder before the parameters' threshold is computed.
-    pub(crate) const PENDING: Self = Self { cos: 0.0, sin: 0.0 };
+    pub(crate) const PENDING: Self = Self {
+        cos: 0.0,
+        sin: 0.0,
+        d_kept: f32::INFINITY,
+    };
 
     /// The threshold `deg` degrees (0 < deg ≤ 180).
     pub(crate) fn new(deg: f32) -> Self {
         let r = deg / RAD_TO_DEG;
+        let (cos, sin) = (math::cos(r), math::sin(r));
         Self {
-            cos: math::cos(r),
-            sin: math::sin(r),
+            cos,
+            sin,
+            d_kept: if cos <= 0.0 && sin >= 0.0 {
+                0.0
+            } else {
+                f32::INFINITY
+            },
         }
     }
 }
@@ -345,10 +358,17 @@ fn judge_b(
 }
 
 /// The irregular test on a = p_i − p_s, b = p_t − p_i (see [`mark_irregular`]).
+///
+/// d first: with cos θ ≤ 0 ≤ sin θ, a d ≥ 0 makes |c|·cos θ ≤ 0 and d·sin θ ≥ 0 (or NaN
+/// from an infinite factor), so the test is false whatever c is; and d = +∞ makes it false
+/// for any θ (−∞ or NaN). So where d ≥ `thr.d_kept` the point is kept without computing c.
 #[inline(always)]
 fn irregular_test(ax: f32, az: f32, bx: f32, bz: f32, thr: Threshold) -> PointStatus {
-    let c = ax * bz - az * bx;
     let d = ax * bx + az * bz;
+    if d >= thr.d_kept {
+        return PointStatus::Kept;
+    }
+    let c = ax * bz - az * bx;
     // With s == i or t == i, c = d = 0 and the test is false: kept.
     if math::abs(c) * thr.cos - d * thr.sin > 0.0 {
         PointStatus::Irregular
@@ -438,7 +458,8 @@ fn windows_sweeps_marked(
 /// are still in registers; elsewhere it is the two calls. The same values either way
 /// (tested). With `LEAN`, a ρ that [`LowCut::below`] puts below τ_min is not computed:
 /// the point gets τ_min itself (see [`LowCut`]); and on the M4F the sweep also finds the
-/// nadir (`seed::nadir`), returned as `Some(nadir)` (`None`: not searched).
+/// nadir (`seed::nadir`), returned as `Some(nadir)` (`None`: not searched). The last
+/// value is the number of points without a neighbour on a side (ρ = 0).
 pub(crate) fn windows_angles<M: Maths, const LEAN: bool>(
     x: &[f32],
     z: &[f32],
@@ -447,11 +468,11 @@ pub(crate) fn windows_angles<M: Maths, const LEAN: bool>(
     t_off: &mut [u8],
     rho: &mut [f32],
     cut: LowCut,
-) -> (u32, Option<Option<usize>>) {
+) -> (u32, Option<Option<usize>>, u32) {
     if cfg!(target_pointer_width = "64") {
         let capped = windows(x, z, d2, s_off, t_off);
-        bend_angles::<M, LEAN>(x, z, s_off, t_off, rho, cut);
-        (capped, None)
+        let lone = bend_angles::<M, LEAN>(x, z, s_off, t_off, rho, cut);
+        (capped, None, lone)
     } else {
         windows_sweeps_angles::<M, LEAN>(x, z, d2, s_off, t_off, rho, cut)
     }
@@ -469,7 +490,7 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
     t_off: &mut [u8],
     rho: &mut [f32],
     cut: LowCut,
-) -> (u32, Option<Option<usize>>) {
+) -> (u32, Option<Option<usize>>, u32) {
     let n = x.len();
     let (z, s_off, t_off, rho) = (&z[..n], &mut s_off[..n], &mut t_off[..n], &mut rho[..n]);
     let mut capped = forward_sweep(x, z, d2, s_off);
@@ -478,6 +499,7 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
     // backwards, a tie replaces, so the lowest index wins. The points are finite here
     // (the kernel set the others aside), so +∞ stands for "none yet".
     let (mut best, mut nadir) = (f32::INFINITY, usize::MAX);
+    let mut lone = 0u32;
     for j in (0..n).rev() {
         let (bx, bz) = back_walk(x, z, d2, j, &mut t, &mut capped);
         t_off[j] = (t - j) as u8;
@@ -489,6 +511,7 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
         }
         let s = j - usize::from(s_off[j]);
         rho[j] = if s == j || t == j {
+            lone += 1;
             0.0
         } else {
             lean_or_exact::<M, LEAN>(x, z, s, j, t, (bx, bz), cut)
@@ -497,6 +520,7 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
     (
         capped,
         LEAN.then_some((nadir != usize::MAX).then_some(nadir)),
+        lone,
     )
 }
 
@@ -646,7 +670,7 @@ fn rho_deg<M: Maths>(cs: f32, d: f32) -> f32 {
 }
 
 /// ρ on the (smoothed) line for every point, with the offsets from [`windows`]; 0 where a
-/// side has no neighbour. `LEAN` and `cut` as in [`windows_angles`].
+/// side has no neighbour (returns how many). `LEAN` and `cut` as in [`windows_angles`].
 #[inline(never)] // its own registers (see `mark_irregular`)
 pub(crate) fn bend_angles<M: Maths, const LEAN: bool>(
     x: &[f32],
@@ -655,18 +679,21 @@ pub(crate) fn bend_angles<M: Maths, const LEAN: bool>(
     t_off: &[u8],
     rho: &mut [f32],
     cut: LowCut,
-) {
+) -> u32 {
     let n = x.len();
     let (z, s_off, t_off, rho) = (&z[..n], &s_off[..n], &t_off[..n], &mut rho[..n]);
+    let mut lone = 0u32;
     for i in 0..n {
         let s = i - usize::from(s_off[i]);
         let t = i + usize::from(t_off[i]);
         rho[i] = if s == i || t == i {
+            lone += 1;
             0.0
         } else {
             lean_or_exact::<M, LEAN>(x, z, s, i, t, (x[t] - x[i], z[t] - z[i]), cut)
         };
     }
+    lone
 }
 
 #[cfg(test)]
@@ -809,7 +836,7 @@ mod tests {
                 assert_eq!(st3[..n], st1[..n], "case {case} d2 {d2}");
                 // The fused angles give what the separate pass gives.
                 let mut rho1 = [0f32; N];
-                bend_angles::<Selected, false>(
+                let lone1 = bend_angles::<Selected, false>(
                     &x[..n],
                     &z[..n],
                     &s1,
@@ -818,7 +845,7 @@ mod tests {
                     LowCut::NONE,
                 );
                 let (mut s4, mut t4, mut rho4) = ([0u8; N], [0u8; N], [0f32; N]);
-                let (c4, _) = windows_sweeps_angles::<Selected, false>(
+                let (c4, _, lone4) = windows_sweeps_angles::<Selected, false>(
                     &x[..n],
                     &z[..n],
                     d2,
@@ -828,6 +855,7 @@ mod tests {
                     LowCut::NONE,
                 );
                 assert_eq!(c4, c1, "case {case} d2 {d2}");
+                assert_eq!(lone4, lone1, "case {case} d2 {d2}");
                 assert_eq!((s4, t4), (s1, t1));
                 for i in 0..n {
                     let (a, b) = (rho1[i], rho4[i]);
@@ -842,7 +870,7 @@ mod tests {
                 let mut rho5 = [0f32; N];
                 bend_angles::<Selected, true>(&x[..n], &z[..n], &s1, &t1, &mut rho5[..n], cut);
                 let (mut s6, mut t6, mut rho6) = ([0u8; N], [0u8; N], [0f32; N]);
-                let (_, nd) = windows_sweeps_angles::<Selected, true>(
+                let (_, nd, _) = windows_sweeps_angles::<Selected, true>(
                     &x[..n],
                     &z[..n],
                     d2,
@@ -876,6 +904,54 @@ mod tests {
                 if case % 4 == 0 && n == N && d2 > 0.0 {
                     assert!(c1 > 0, "the run of coincident points caps windows");
                 }
+            }
+        }
+    }
+
+    /// The test that skips c where d decides is the full test, for any threshold and any
+    /// a, b (zeros of both signs, infinities and NaN included).
+    #[test]
+    fn irregular_test_skipping_c_is_the_full_test() {
+        let mut r = 99u64;
+        let mut u = || {
+            r = r
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((r >> 40) as f32) / ((1u64 << 24) as f32) - 0.5
+        };
+        let special = [
+            0.0f32,
+            -0.0,
+            1e-30,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        for deg in [1.0f32, 45.0, 89.9, 90.0, 90.1, 120.0, 179.0, 180.0] {
+            let thr = Threshold::new(deg);
+            let full = |ax: f32, az: f32, bx: f32, bz: f32| {
+                let c = ax * bz - az * bx;
+                let d = ax * bx + az * bz;
+                if math::abs(c) * thr.cos - d * thr.sin > 0.0 {
+                    PointStatus::Irregular
+                } else {
+                    PointStatus::Kept
+                }
+            };
+            for k in 0..20_000 {
+                let mut v = [u(), u(), u(), u()];
+                if k % 7 == 0 {
+                    v[k % 4] = special[k / 7 % special.len()];
+                }
+                if k % 11 == 0 {
+                    v[(k + 1) % 4] = special[k / 11 % special.len()];
+                }
+                let [ax, az, bx, bz] = v;
+                assert_eq!(
+                    irregular_test(ax, az, bx, bz, thr),
+                    full(ax, az, bx, bz),
+                    "{deg} {v:?}"
+                );
             }
         }
     }

@@ -354,7 +354,7 @@ impl<const N: usize> Kernel<N> {
         // 4. ρ on the smoothed line.
         let s_off = &mut s_off[..kept];
         let (t_off, rk) = (&mut aux[..kept], &mut rho[..kept]);
-        let (capped, swept_nadir) = if lean {
+        let (capped, swept_nadir, lone) = if lean {
             bend::windows_angles::<M, true>(xk, zk, d2, s_off, t_off, rk, low_cut)
         } else {
             bend::windows_angles::<M, false>(xk, zk, d2, s_off, t_off, rk, bend::LowCut::NONE)
@@ -393,8 +393,9 @@ impl<const N: usize> Kernel<N> {
             seed::seed_candidates::<true>(args, &mut aux[..kept], &mut self.deque)
         };
         c.peaks = seeds.peaks;
-        c.no_neighbour = seeds.no_neighbour;
-        c.kept = kept as u32 - seeds.no_neighbour;
+        // The lean peak pass leaves the points without a neighbour to the sweep's count.
+        c.no_neighbour = if lean { lone } else { seeds.no_neighbour };
+        c.kept = kept as u32 - c.no_neighbour;
 
         // 6. Back to input order: replay the partition's swaps backwards.
         let mut idx = [nadir, seeds.left, seeds.right];

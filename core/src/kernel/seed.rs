@@ -79,7 +79,11 @@ pub(crate) struct SeedArgs<'a> {
 /// s(k)) up to t(k). Both window ends only move forward, so every index enters at most
 /// once: O(n) in the worst case, and nearly nothing on plain road.
 ///
-/// Without `STATUS` (a lean pass, see `Kernel::set_lean_rho`) `aux` is only read.
+/// Without `STATUS` (a lean pass, see `Kernel::set_lean_rho`) `aux` is only read, and
+/// the points without a neighbour are not counted (the lean sweep counted them,
+/// `bend::windows_angles`): only the points with ρ above τ_min are looked at, found by a
+/// scan of ρ alone. The others cannot be peaks, and a point without a neighbour has ρ = 0,
+/// not above τ_min (≥ 0); its window is still checked before it is taken as a peak.
 pub(crate) fn seed_candidates<const STATUS: bool>(
     args: SeedArgs<'_>,
     aux: &mut [u8],
@@ -104,7 +108,17 @@ pub(crate) fn seed_candidates<const STATUS: bool>(
     let mut right: Option<(usize, usize, f32)> = None;
     let (mut head, mut tail) = (0usize, 0usize);
     let mut next = 0usize;
-    for k in 0..n {
+    let mut at = 0usize;
+    while at < n {
+        if !STATUS {
+            // The next point with ρ above τ_min (a scan of ρ alone).
+            match rho[at..].iter().position(|&r| r > tau_min) {
+                Some(o) => at += o,
+                None => break,
+            }
+        }
+        let k = at;
+        at += 1;
         let s = k - usize::from(s_off[k]);
         let t = k + usize::from(aux[k]);
         // No neighbour on a side: rare (line ends, isolated points), so a branch rather
@@ -112,8 +126,8 @@ pub(crate) fn seed_candidates<const STATUS: bool>(
         if s == k || t == k {
             if STATUS {
                 aux[k] = PointStatus::NoNeighbour as u8;
+                out.no_neighbour += 1;
             }
-            out.no_neighbour += 1;
             continue;
         }
         if STATUS {

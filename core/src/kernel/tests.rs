@@ -709,7 +709,7 @@ fn stage_timings() {
             &t_off,
             &mut rho,
             bend::LowCut::NONE,
-        )
+        );
     });
     std::println!("bend_angles: {r:.1?} ns/pt");
     let (mut xs, mut zs) = (x.clone(), z.clone());
