@@ -32,7 +32,8 @@
 //! computes no more than that needs: no arctangent where ρ is certainly below τ_min
 //! ([`bend::LowCut`]), the region's points compacted rather than partitioned, the kept
 //! points' partition not undone (only the three indices mapped back), no per-point
-//! statuses, the nadir found inside the smoothed pass's sweep. The packet is the same byte
+//! statuses, the nadir and the points without a neighbour found inside the smoothed pass's
+//! sweep, and the peak pass looking only at points whose ρ is above τ_min. The packet is the same byte
 //! for byte (tested, and compared on whole streams by `firmware/check.sh`).
 //!
 //! # Memory
