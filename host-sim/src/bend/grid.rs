@@ -2,8 +2,9 @@
 //! and the post-filters' neighbourhood queries. Points are bucketed by a counting sort
 //! (two passes, no comparison sort): 4 bytes per point for the sorted indices plus 4
 //! bytes per cell, with the cell grown (never below the requested size) until there are at
-//! most half as many cells as points — about 6 bytes per point in all. A query visits only
-//! the cells the disc touches, never the whole cloud.
+//! most half as many cells as points — about 6 bytes per point in all, and a bit per point
+//! while it is built. A query visits only the cells the disc touches, never the whole
+//! cloud.
 
 /// Point indices bucketed by a square XY cell over the points' bounding box.
 pub struct PointGrid {
@@ -21,9 +22,13 @@ pub struct PointGrid {
 impl PointGrid {
     /// Indexes the points `i` with `keep(i)` true (and finite coordinates), in cells of at
     /// least `cell_m` metres.
+    ///
+    /// `keep` is asked once per point; the answers are kept as a bitmap (one bit per point)
+    /// for the two passes of the counting sort.
     pub fn build(x: &[f64], y: &[f64], cell_m: f64, keep: impl Fn(usize) -> bool) -> Self {
         let n = x.len().min(y.len()).min(u32::MAX as usize - 1);
-        let ok = |i: usize| keep(i) && x[i].is_finite() && y[i].is_finite();
+        let (x, y) = (&x[..n], &y[..n]);
+        let mut kept = vec![0u64; n.div_ceil(64)];
         let (mut x0, mut y0, mut x1, mut y1) = (
             f64::INFINITY,
             f64::INFINITY,
@@ -31,12 +36,13 @@ impl PointGrid {
             f64::NEG_INFINITY,
         );
         let mut count = 0usize;
-        for i in 0..n {
-            if ok(i) {
-                x0 = x0.min(x[i]);
-                y0 = y0.min(y[i]);
-                x1 = x1.max(x[i]);
-                y1 = y1.max(y[i]);
+        for (i, (&px, &py)) in x.iter().zip(y).enumerate() {
+            if px.is_finite() && py.is_finite() && keep(i) {
+                kept[i >> 6] |= 1 << (i & 63);
+                x0 = x0.min(px);
+                y0 = y0.min(py);
+                x1 = x1.max(px);
+                y1 = y1.max(py);
                 count += 1;
             }
         }
@@ -75,31 +81,23 @@ impl PointGrid {
             starts: vec![0u32; nx * ny + 1],
             order: Vec::new(),
         };
-        for i in 0..n {
-            if ok(i) {
-                let c = g.cell_index(x[i], y[i]);
-                g.starts[c + 1] += 1;
-            }
-        }
+        // The cells are computed twice rather than kept (4 bytes a point more while the
+        // grid is built, for no time measured).
+        let cells = CellOf::new(&g);
+        for_each_set(&kept, |i| {
+            g.starts[cells.at(x[i], y[i]) + 1] += 1;
+        });
         for c in 0..nx * ny {
             g.starts[c + 1] += g.starts[c];
         }
         let mut fill = g.starts.clone();
         g.order = vec![0u32; count];
-        for i in 0..n {
-            if ok(i) {
-                let c = g.cell_index(x[i], y[i]);
-                g.order[fill[c] as usize] = i as u32;
-                fill[c] += 1;
-            }
-        }
+        for_each_set(&kept, |i| {
+            let c = cells.at(x[i], y[i]);
+            g.order[fill[c] as usize] = i as u32;
+            fill[c] += 1;
+        });
         g
-    }
-
-    fn cell_index(&self, x: f64, y: f64) -> usize {
-        let cx = (((x - self.x0) / self.cell_m) as usize).min(self.nx - 1);
-        let cy = (((y - self.y0) / self.cell_m) as usize).min(self.ny - 1);
-        cy * self.nx + cx
     }
 
     /// Calls `f(i)` for every indexed point within `r` (horizontal) of `(px, py)`, in a
@@ -117,8 +115,8 @@ impl PointGrid {
             return;
         }
         let span = |lo: f64, hi: f64, n: usize| -> Option<(usize, usize)> {
-            let a = (lo / self.cell_m).floor();
-            let b = (hi / self.cell_m).floor();
+            let a = floor(lo / self.cell_m);
+            let b = floor(hi / self.cell_m);
             if b < 0.0 || a >= n as f64 {
                 return None;
             }
@@ -161,6 +159,77 @@ impl PointGrid {
     /// Cell size in use, metres (at least the one asked for).
     pub fn cell_m(&self) -> f64 {
         self.cell_m
+    }
+}
+
+/// `v.floor()` without the libm call (x86-64 has no rounding instruction in its baseline):
+/// the same value for every `v` (−0 comes back as +0), through an integer where `v` fits
+/// one exactly.
+fn floor(v: f64) -> f64 {
+    if v.abs() < 4.0e15 {
+        let t = v as i64 as f64;
+        if t > v {
+            t - 1.0
+        } else {
+            t
+        }
+    } else {
+        v.floor()
+    }
+}
+
+/// Calls `f(i)` for every bit `i` set in `bits`, ascending.
+fn for_each_set(bits: &[u64], mut f: impl FnMut(usize)) {
+    for (w, &word) in bits.iter().enumerate() {
+        let mut b = word;
+        while b != 0 {
+            f(w * 64 + b.trailing_zeros() as usize);
+            b &= b - 1;
+        }
+    }
+}
+
+/// The cell of a point inside the grid's box: `⌊(v − v0) / cell⌋` on each axis, clamped to
+/// the last cell. A multiplication by the reciprocal gives the same floor unless the
+/// quotient lies within 10⁻⁶ of an integer (product and quotient differ by a few ulp,
+/// far below that on any grid of fewer than 10⁹ cells a side); only then is the division
+/// done, so every point lands in the cell the division puts it in.
+struct CellOf {
+    x0: f64,
+    y0: f64,
+    cell: f64,
+    inv: f64,
+    nx: usize,
+    ny: usize,
+}
+
+impl CellOf {
+    fn new(g: &PointGrid) -> Self {
+        Self {
+            x0: g.x0,
+            y0: g.y0,
+            cell: g.cell_m,
+            inv: 1.0 / g.cell_m,
+            nx: g.nx,
+            ny: g.ny,
+        }
+    }
+
+    /// `d ≥ 0` (inside the box), so truncation is the floor.
+    fn axis(&self, d: f64, n: usize) -> usize {
+        let q = d * self.inv;
+        let k = q as usize;
+        let frac = q - k as f64;
+        let k = if frac > 1e-6 && frac < 1.0 - 1e-6 {
+            k
+        } else {
+            (d / self.cell) as usize
+        };
+        k.min(n - 1)
+    }
+
+    fn at(&self, x: f64, y: f64) -> usize {
+        self.axis(y - self.y0, self.ny) * self.nx + self.axis(x - self.x0, self.nx)
     }
 }
 
@@ -213,6 +282,58 @@ mod tests {
         got.clear();
         g.for_each_within(&x, &y, -5.0, 0.0, 1.0, |i| got.push(i));
         assert!(got.is_empty());
+    }
+
+    #[test]
+    fn points_on_cell_boundaries_fall_where_the_division_puts_them() {
+        // Coordinates at multiples of 0.1 m (0.1 is not exact in binary: k·0.1 lands a few
+        // ulp either side of a boundary) far from the origin, and a scatter between them.
+        let mut x = Vec::new();
+        let mut y = Vec::new();
+        for k in 0..400u32 {
+            x.push(300_000.0 + f64::from(k % 20) * 0.1);
+            y.push(5_000_000.0 + f64::from(k / 20) * 0.1);
+            x.push(300_000.0 + f64::from(k.wrapping_mul(2_654_435_761) % 1_900) * 1e-3);
+            y.push(5_000_000.0 + f64::from(k.wrapping_mul(40_503) % 1_900) * 1e-3);
+        }
+        let g = PointGrid::build(&x, &y, 0.1, |_| true);
+        assert_eq!(g.cell_m(), 0.1);
+        let (x0, y0) = (300_000.0, 5_000_000.0);
+        let last = |v: &[f64], v0: f64| {
+            let v1 = v.iter().copied().fold(v0, f64::max);
+            ((v1 - v0) / 0.1).floor() as usize
+        };
+        let (lx, ly) = (last(&x, x0), last(&y, y0));
+        let cell = |v: f64, v0: f64, l: usize| (((v - v0) / 0.1) as usize).min(l);
+        // Every cell of the box in turn, row by row, indices ascending within a cell.
+        let mut want: Vec<usize> = (0..x.len()).collect();
+        want.sort_by_key(|&i| (cell(y[i], y0, ly), cell(x[i], x0, lx), i));
+        let mut got = Vec::new();
+        g.for_each_within(&x, &y, x0 + 1.0, y0 + 1.0, 5.0, |i| got.push(i));
+        assert_eq!(got, want);
+    }
+
+    #[test]
+    fn floor_is_the_floor() {
+        for v in [
+            -2.5,
+            -1.0,
+            -0.999,
+            -1e-300,
+            0.0,
+            1e-300,
+            0.5,
+            1.0,
+            7.999_999_999,
+            4.5e15,
+            -4.5e15,
+            1e300,
+            -1e300,
+        ] {
+            assert_eq!(floor(v), v.floor(), "{v}");
+        }
+        assert!(floor(f64::NAN).is_nan());
+        assert_eq!(floor(f64::NEG_INFINITY), f64::NEG_INFINITY);
     }
 
     #[test]
