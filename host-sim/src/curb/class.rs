@@ -10,11 +10,17 @@ use crate::model::{Category, CurbDetail, EdgeLine, Side};
 /// Angle between the edge and the route above which a vertex is on an intersection
 /// (corner arc or side street), degrees.
 pub const TURN_DEG: f64 = 30.0;
-/// Angle above which a vertex next to an intersection run still belongs to it: a corner
-/// arc starts tangent to the curb, so its first part turns less than [`TURN_DEG`] (an arc
-/// of radius R turns 30° over 0.52·R). Well above the angle a straight curb shows against
-/// the route (a few degrees: the vehicle's wander, the tangent's noise).
-pub const TURN_GROW_DEG: f64 = 8.0;
+/// Turn rate of the edge itself (degrees per metre, the tangent's change over
+/// ±[`TURN_RATE_HALF_M`]) above which a vertex next to an intersection run still belongs to
+/// it: a corner arc starts tangent to the curb, so its first part turns less than
+/// [`TURN_DEG`] from the route, but the edge keeps turning there. An arc of radius 57 m turns
+/// 1°/m: corner arcs, also the wide first part of a flared corner, turn faster, while a
+/// straight curb's tangent wanders by less than half of that. The edge's own turn, not its
+/// angle to the route, so that a curb the vehicle's lane change leaves at an angle to the
+/// route does not join.
+pub const TURN_RATE_DEG_M: f64 = 1.0;
+/// Half the reach along the edge over which its turn rate is taken, metres.
+pub const TURN_RATE_HALF_M: f64 = 0.5;
 /// How much wider than usual the road is at a bus bay or setback, metres.
 pub const BAY_MIN_M: f64 = 0.5;
 /// How far a vertex with no curb on the other side stands out from its side's usual
@@ -81,6 +87,7 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
                 .collect()
         })
         .collect();
+    let rate: Vec<Vec<f64>> = edges.iter().map(|e| turn_rate(&e.points)).collect();
     // Vertices running along the route, per side, by station: (station, offset).
     let mut along: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
     for (e, g) in edges.iter().zip(&geo) {
@@ -119,7 +126,7 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
         quantile(along[0].iter().map(|p| p.1).collect()),
         quantile(along[1].iter().map(|p| p.1).collect()),
     ];
-    for (e, g) in edges.iter_mut().zip(&geo) {
+    for ((e, g), r) in edges.iter_mut().zip(&geo).zip(&rate) {
         let side = usize::from(e.side == Side::Right);
         let Some(d) = e.detail.as_mut() else { continue };
         d.class = g
@@ -147,8 +154,7 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
                 }
             })
             .collect();
-        let angle: Vec<f64> = g.iter().map(|g| g.0).collect();
-        grow_intersections(&angle, &mut d.class);
+        grow_intersections(r, &mut d.class);
     }
     // An edge that ends where another edge's intersection run ends continues the corner:
     // its end grows into the intersection too.
@@ -164,7 +170,7 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
                 .collect::<Vec<_>>()
         })
         .collect();
-    for (e, g) in edges.iter_mut().zip(&geo) {
+    for (e, r) in edges.iter_mut().zip(&rate) {
         let side = e.side;
         let m = e.points.len();
         let near_corner = |p: [f64; 3]| {
@@ -174,7 +180,9 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
         };
         let ends: Vec<usize> = [0, m.saturating_sub(1)]
             .into_iter()
-            .filter(|&k| g.get(k).is_some_and(|g| g.0 > TURN_GROW_DEG) && near_corner(e.points[k]))
+            .filter(|&k| {
+                r.get(k).is_some_and(|r| r.abs() >= TURN_RATE_DEG_M) && near_corner(e.points[k])
+            })
             .collect();
         let Some(d) = e.detail.as_mut() else { continue };
         if ends.is_empty() || d.class.len() != m {
@@ -183,8 +191,7 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
         for k in ends {
             d.class[k] = Category::Intersection;
         }
-        let angle: Vec<f64> = g.iter().map(|g| g.0).collect();
-        grow_intersections(&angle, &mut d.class);
+        grow_intersections(r, &mut d.class);
     }
     // A bus bay is a recess: its side's curb is back on its usual line within BAY_RETURN_M
     // before and after it (clearly back: within half the thresholds that make a bay). Other
@@ -318,20 +325,61 @@ pub fn settle_runs(edges: &mut [EdgeLine]) {
     }
 }
 
-/// Extends every intersection run over the vertices beside it that still turn more than
-/// [`TURN_GROW_DEG`] from the route (the start of a corner arc).
-fn grow_intersections(angle: &[f64], class: &mut [Category]) {
-    let m = angle.len().min(class.len());
+/// Extends every intersection run over the vertices beside it where the edge still turns
+/// at least [`TURN_RATE_DEG_M`] (the start of a corner arc), and the same way as the run's
+/// vertex beside it where that one turns as much (an S-bend is not one corner).
+fn grow_intersections(rate: &[f64], class: &mut [Category]) {
+    let m = rate.len().min(class.len());
+    let joins = |k: usize, j: usize| {
+        rate[k].abs() >= TURN_RATE_DEG_M
+            && (rate[j].abs() < TURN_RATE_DEG_M || rate[k] * rate[j] > 0.0)
+    };
     for k in 1..m {
-        if class[k - 1] == Category::Intersection && angle[k] > TURN_GROW_DEG {
+        if class[k - 1] == Category::Intersection
+            && class[k] != Category::Intersection
+            && joins(k, k - 1)
+        {
             class[k] = Category::Intersection;
         }
     }
     for k in (0..m.saturating_sub(1)).rev() {
-        if class[k + 1] == Category::Intersection && angle[k] > TURN_GROW_DEG {
+        if class[k + 1] == Category::Intersection
+            && class[k] != Category::Intersection
+            && joins(k, k + 1)
+        {
             class[k] = Category::Intersection;
         }
     }
+}
+
+/// The edge's own turn rate at every vertex, degrees per metre, positive to the left: the
+/// change of its tangent between the vertices [`TURN_RATE_HALF_M`] before and after it,
+/// over the length between them (0 where the edge is shorter than that).
+fn turn_rate(pts: &[[f64; 3]]) -> Vec<f64> {
+    let s = arc(pts);
+    let m = pts.len();
+    (0..m)
+        .map(|k| {
+            let mut a = k;
+            while a > 0 && s[k] - s[a] < TURN_RATE_HALF_M {
+                a -= 1;
+            }
+            let mut b = k;
+            while b + 1 < m && s[b] - s[k] < TURN_RATE_HALF_M {
+                b += 1;
+            }
+            match (
+                tangent(pts, a, TURN_RATE_HALF_M),
+                tangent(pts, b, TURN_RATE_HALF_M),
+            ) {
+                (Some(ta), Some(tb)) if s[b] - s[a] >= TURN_RATE_HALF_M => {
+                    let turn = (ta[0] * tb[1] - ta[1] * tb[0]).atan2(ta[0] * tb[0] + ta[1] * tb[1]);
+                    turn.to_degrees() / (s[b] - s[a])
+                }
+                _ => 0.0,
+            }
+        })
+        .collect()
 }
 
 /// Extends every curb-cut run over its transitions (on the closed edge): the curb vertices
@@ -535,31 +583,66 @@ mod tests {
 
     #[test]
     fn an_intersection_run_takes_the_start_of_its_corner_arc() {
-        // The angle to the route rises 0°, 2°, … 60°: 30° and above is an intersection, and
-        // the vertices beside the run down to 8° join it; a lone 10° wobble elsewhere does
-        // not.
-        let mut angle: Vec<f64> = (0..31).map(|k| 2.0 * k as f64).collect();
-        angle.extend([0.0, 10.0, 0.0]);
-        let mut class: Vec<Category> = angle
-            .iter()
-            .map(|&a| {
-                if a > TURN_DEG {
+        // A straight curb along the route (x) for 5 m, then a flared corner's first arc:
+        // radius 30 m, turning left 60°, vertices 0.1 m apart. Past 30° from the route the
+        // arc is an intersection; the run takes the arc down to where it leaves the curb
+        // (within the ±0.5 m the turn rate is taken over), the straight curb stays curb.
+        let mut p: Vec<[f64; 3]> = (0..50).map(|i| [i as f64 * 0.1 - 5.0, 0.0, 0.0]).collect();
+        let r = 30.0;
+        let arc_n = (r * 60f64.to_radians() / 0.1) as usize;
+        p.extend((0..=arc_n).map(|i| {
+            let t = i as f64 * 0.1 / r;
+            [r * t.sin(), r * (1.0 - t.cos()), 0.0]
+        }));
+        let s = arc(&p);
+        let angle =
+            |k: usize| tangent(&p, k, 0.5).map_or(0.0, |t| t[1].atan2(t[0]).to_degrees().abs());
+        let mut class: Vec<Category> = (0..p.len())
+            .map(|k| {
+                if angle(k) > TURN_DEG {
                     Category::Intersection
                 } else {
                     Category::Curb
                 }
             })
             .collect();
-        grow_intersections(&angle, &mut class);
-        for (k, &a) in angle.iter().enumerate().take(31) {
-            let want = if a > TURN_GROW_DEG {
-                Category::Intersection
-            } else {
-                Category::Curb
-            };
-            assert_eq!(class[k], want, "vertex {k} at {a}°");
+        let first = class.iter().position(|&c| c == Category::Intersection);
+        assert!(
+            first.is_some_and(|k| s[k] > 15.0),
+            "30° lies 15.7 m into the arc"
+        );
+        grow_intersections(&turn_rate(&p), &mut class);
+        for (k, &c) in class.iter().enumerate() {
+            // The tangent point lies at s = 5 m.
+            if s[k] >= 5.0 {
+                assert_eq!(c, Category::Intersection, "arc vertex at s = {:.1} m", s[k]);
+            } else if s[k] <= 4.0 {
+                assert_eq!(c, Category::Curb, "straight vertex at s = {:.1} m", s[k]);
+            }
         }
-        assert_eq!(class[32], Category::Curb);
+    }
+
+    #[test]
+    fn a_straight_curb_at_an_angle_to_the_route_stays_curb_beside_a_corner() {
+        // A straight curb 12° from the route (where the vehicle changes lanes) for 5 m, then
+        // a side street's straight curb at 70°. Above the old 8° rule, the straight curb is
+        // not a corner arc: only the vertices within the ±0.5 m of the kink, where the
+        // edge turns, join the intersection.
+        let dir = |deg: f64| [deg.to_radians().cos(), deg.to_radians().sin()];
+        let (d1, d2) = (dir(12.0), dir(70.0));
+        let mut p: Vec<[f64; 3]> = (0..=50)
+            .map(|i| [d1[0] * i as f64 * 0.1, d1[1] * i as f64 * 0.1, 0.0])
+            .collect();
+        let kink = p[50];
+        p.extend((1..=30).map(|i| {
+            let t = i as f64 * 0.1;
+            [kink[0] + d2[0] * t, kink[1] + d2[1] * t, 0.0]
+        }));
+        let mut class = vec![Category::Curb; 51];
+        class.extend([Category::Intersection; 30]);
+        grow_intersections(&turn_rate(&p), &mut class);
+        assert!(class[..=40].iter().all(|&c| c == Category::Curb));
+        assert!(class[51..].iter().all(|&c| c == Category::Intersection));
     }
 
     #[test]
