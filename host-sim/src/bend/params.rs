@@ -103,6 +103,14 @@ pub struct BendParams {
     /// is there between the scanlines. 15 m reaches the far curb of a 14 m road from the
     /// near lane.
     pub profile_seed_reach_m: f64,
+    /// Longest stretch, metres, a track follows a curb cut's toe on virtual profiles
+    /// (`profile::cut_toe`: the break of slope where the lip is under
+    /// `profile_min_step_m`, down to none) after the bend angle and the step have both
+    /// faded (0 = never). Not in the paper: a cut's toe has no bend angle worth the name
+    /// and no step, yet it continues the curb's line; where no track waits on the cut's
+    /// far side to bridge to (the end of the drive, a cut beside a side street) it was
+    /// lost. 15 m is a 12 m cut with both transitions.
+    pub cut_follow_max_m: f64,
     /// Upper bound of steps per track (per direction): a safety net only.
     pub max_steps: u32,
     /// Distance, metres, within which a track is taken to have reached another track (it
@@ -204,6 +212,7 @@ impl Default for BendParams {
             profile_min_step_m: 0.05,
             profile_max_slope: 0.1,
             profile_seed_reach_m: 15.0,
+            cut_follow_max_m: 15.0,
             max_steps: 200_000,
             join_distance_m: 0.05,
             bridge_max_m: 12.0,

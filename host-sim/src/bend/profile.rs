@@ -53,59 +53,15 @@ pub fn profile_toe(
 ) -> Option<ProfileToe> {
     let half_w = params.profile_half_width_m;
     let n = [-along[1] * up, along[0] * up];
-    // (across, z, along) per point.
-    let mut prof: Vec<(f64, f64, f64)> = Vec::new();
-    grid.for_each_within(
-        input.x,
-        input.y,
-        centre[0],
-        centre[1],
-        half_w.hypot(half_l),
-        |i| {
-            if !usable(input, i) || (input.z[i] - centre[2]).abs() > params.search_half_height_m {
-                return;
-            }
-            let d = [input.x[i] - centre[0], input.y[i] - centre[1]];
-            let a = d[0] * along[0] + d[1] * along[1];
-            let c = d[0] * n[0] + d[1] * n[1];
-            if a.abs() <= half_l && c.abs() <= half_w {
-                prof.push((c, input.z[i], a));
-            }
-        },
-    );
     const MIN_SIDE: usize = 4;
+    let prof = gather(input, grid, centre, along, up, half_l, params);
     if prof.len() < 2 * MIN_SIDE {
         return None;
     }
-    prof.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
-    // Prefix sums of 1, c, c², z, c·z, z² (heights relative to the first point, for
-    // precision): a least-squares line over any run of the sorted points in O(1).
-    let z0 = prof[0].1;
     let m = prof.len();
-    let mut acc = vec![[0.0f64; 6]; m + 1];
-    for (k, p) in prof.iter().enumerate() {
-        let (c, z) = (p.0, p.1 - z0);
-        let t = [1.0, c, c * c, z, c * z, z * z];
-        for j in 0..6 {
-            acc[k + 1][j] = acc[k][j] + t[j];
-        }
-    }
-    // Line z = a + b·c over prof[lo..hi]: (a, b, sse). Slope 0 when the run has a single
-    // position (one scanline beside a side street's curb).
-    let line = |lo: usize, hi: usize| -> (f64, f64, f64) {
-        let s: Vec<f64> = (0..6).map(|j| acc[hi][j] - acc[lo][j]).collect();
-        let (n, sc, scc, sz, scz, szz) = (s[0], s[1], s[2], s[3], s[4], s[5]);
-        let den = n * scc - sc * sc;
-        let b = if den > 1e-9 * n * n {
-            (n * scz - sc * sz) / den
-        } else {
-            0.0
-        };
-        let a = (sz - b * sc) / n;
-        // Σ(z − a − b·c)² expanded.
-        let sse = szz - 2.0 * a * sz - 2.0 * b * scz + n * a * a + 2.0 * a * b * sc + b * b * scc;
-        (a, b, sse.max(0.0))
-    };
+    let sums = Sums::new(&prof);
+    let line = |lo: usize, hi: usize| sums.line(lo, hi);
+    let acc = &sums.acc;
     // Σ(z − mean)² over prof[lo..hi].
     let level_sse = |lo: usize, hi: usize| {
         let (n, sz, szz) = (
@@ -181,5 +137,187 @@ pub fn profile_toe(
             z,
         ],
         step_m: step,
+    })
+}
+
+/// The points of a virtual profile (see [`profile_toe`]) as (across, z, along), sorted by
+/// `across`, then height.
+fn gather(
+    input: &BendInput,
+    grid: &PointGrid,
+    centre: [f64; 3],
+    along: [f64; 2],
+    up: f64,
+    half_l: f64,
+    params: &BendParams,
+) -> Vec<(f64, f64, f64)> {
+    let half_w = params.profile_half_width_m;
+    let n = [-along[1] * up, along[0] * up];
+    let mut prof: Vec<(f64, f64, f64)> = Vec::new();
+    grid.for_each_within(
+        input.x,
+        input.y,
+        centre[0],
+        centre[1],
+        half_w.hypot(half_l),
+        |i| {
+            if !usable(input, i) || (input.z[i] - centre[2]).abs() > params.search_half_height_m {
+                return;
+            }
+            let d = [input.x[i] - centre[0], input.y[i] - centre[1]];
+            let a = d[0] * along[0] + d[1] * along[1];
+            let c = d[0] * n[0] + d[1] * n[1];
+            if a.abs() <= half_l && c.abs() <= half_w {
+                prof.push((c, input.z[i], a));
+            }
+        },
+    );
+    prof.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
+    prof
+}
+
+/// Prefix sums of 1, c, c², z, c·z, z² over a sorted profile (heights relative to the
+/// first point, for precision): a least-squares line over any run of its points in O(1).
+struct Sums {
+    acc: Vec<[f64; 6]>,
+}
+
+impl Sums {
+    fn new(prof: &[(f64, f64, f64)]) -> Self {
+        let z0 = prof.first().map_or(0.0, |p| p.1);
+        let mut acc = vec![[0.0f64; 6]; prof.len() + 1];
+        for (k, p) in prof.iter().enumerate() {
+            let (c, z) = (p.0, p.1 - z0);
+            let t = [1.0, c, c * c, z, c * z, z * z];
+            for j in 0..6 {
+                acc[k + 1][j] = acc[k][j] + t[j];
+            }
+        }
+        Self { acc }
+    }
+
+    /// Line z = a + b·c over prof[lo..hi]: (a, b, sse), heights relative to the first
+    /// point. Slope 0 when the run has a single position (one scanline beside a side
+    /// street's curb).
+    fn line(&self, lo: usize, hi: usize) -> (f64, f64, f64) {
+        let acc = &self.acc;
+        let s: Vec<f64> = (0..6).map(|j| acc[hi][j] - acc[lo][j]).collect();
+        let (n, sc, scc, sz, scz, szz) = (s[0], s[1], s[2], s[3], s[4], s[5]);
+        let den = n * scc - sc * sc;
+        let b = if den > 1e-9 * n * n {
+            (n * scz - sc * sz) / den
+        } else {
+            0.0
+        };
+        let a = (sz - b * sc) / n;
+        // Σ(z − a − b·c)² expanded.
+        let sse = szz - 2.0 * a * sz - 2.0 * b * scz + n * a * a + 2.0 * a * b * sc + b * b * scc;
+        (a, b, sse.max(0.0))
+    }
+}
+
+/// Farthest a curb cut's toe may lie across the profile from its centre, metres: a cut
+/// keeps the line of the curb it interrupts, so the toe stays where the track predicts it.
+const CUT_MAX_OFFSET_M: f64 = 0.1;
+
+/// Least rise of the ground behind a curb cut's toe over the road's own line, taken
+/// [`CUT_RISE_AT_M`] behind the toe, metres. A 1:12 ramp rises 21 mm there, a lip of 15 mm
+/// or more gives it at once; a road's crown or rut does not.
+const CUT_MIN_RISE_M: f64 = 0.015;
+
+/// Distance behind the toe at which [`CUT_MIN_RISE_M`] is measured, metres.
+const CUT_RISE_AT_M: f64 = 0.25;
+
+/// Steepest ground behind a curb cut's toe (a ramp of 1:3), as a slope.
+const CUT_MAX_RAMP: f64 = 0.35;
+
+/// Largest RMS of the two lines of a curb cut's profile about its points, metres: twice
+/// the largest range noise of the scanners simulated and modelled.
+const CUT_MAX_RMS_M: f64 = 0.02;
+
+/// Finds the toe of a *curb cut* on a virtual profile (the same points as
+/// [`profile_toe`]): where the lip is too low for a step (0–50 mm, down to none) the toe is
+/// the break of slope between the road, falling towards the curb line, and the lip, ramp
+/// or lowered sidewalk behind it, rising away from it. The sorted points are split in two
+/// where two independent least-squares lines fit them best; the split is accepted as the
+/// toe when the road part is ground-like (slope under `profile_max_slope`), the part
+/// behind it rises no steeper than a 1:3 ramp and at least [`CUT_MIN_RISE_M`] above the
+/// road's line [`CUT_RISE_AT_M`] behind the toe (and never falls below it at the toe), the
+/// lines fit within [`CUT_MAX_RMS_M`], ground is seen within 0.15 m on both sides, and the
+/// toe lies within [`CUT_MAX_OFFSET_M`] of the centre. Meant only for continuing a track
+/// along a curb line, where the prediction says where the toe is: on its own the break
+/// would be too weak a sign of a curb.
+pub fn cut_toe(
+    input: &BendInput,
+    grid: &PointGrid,
+    centre: [f64; 3],
+    along: [f64; 2],
+    up: f64,
+    half_l: f64,
+    params: &BendParams,
+) -> Option<ProfileToe> {
+    const MIN_SIDE: usize = 6;
+    const NEAR_M: f64 = 0.15;
+    let n = [-along[1] * up, along[0] * up];
+    let prof = gather(input, grid, centre, along, up, half_l, params);
+    let m = prof.len();
+    if m < 2 * MIN_SIDE {
+        return None;
+    }
+    let sums = Sums::new(&prof);
+    let z0 = prof[0].1;
+    let mut best: Option<(f64, usize)> = None;
+    for k in MIN_SIDE..=m - MIN_SIDE {
+        if prof[k].0 - prof[k - 1].0 <= 0.0 {
+            continue;
+        }
+        let toe = 0.5 * (prof[k - 1].0 + prof[k].0);
+        if toe.abs() > CUT_MAX_OFFSET_M {
+            continue;
+        }
+        let e = sums.line(0, k).2 + sums.line(k, m).2;
+        if best.is_none_or(|(be, _)| e < be) {
+            best = Some((e, k));
+        }
+    }
+    let (sse, k) = best?;
+    let toe = 0.5 * (prof[k - 1].0 + prof[k].0);
+    if prof[k].0 - toe > NEAR_M || toe - prof[k - 1].0 > NEAR_M {
+        return None; // no ground seen right beside the toe
+    }
+    // Both parts must reach far enough from the toe for their slopes to mean something.
+    if toe - prof[0].0 < 2.0 * NEAR_M || prof[m - 1].0 - toe < 2.0 * NEAR_M {
+        return None;
+    }
+    let (la, lb, _) = sums.line(0, k);
+    let (ha, hb, _) = sums.line(k, m);
+    if lb.abs() > params.profile_max_slope || hb > CUT_MAX_RAMP {
+        return None;
+    }
+    let road = |c: f64| la + lb * c;
+    let back = |c: f64| ha + hb * c;
+    let step = back(toe) - road(toe);
+    let rise = back(toe + CUT_RISE_AT_M) - road(toe + CUT_RISE_AT_M);
+    let rms = (sse / m as f64).sqrt();
+    if step < -0.005 || rise < CUT_MIN_RISE_M.max(rms) || rms > CUT_MAX_RMS_M {
+        return None;
+    }
+    let a = prof
+        .iter()
+        .filter(|p| (p.0 - toe).abs() <= NEAR_M)
+        .map(|p| p.2)
+        .sum::<f64>()
+        / prof
+            .iter()
+            .filter(|p| (p.0 - toe).abs() <= NEAR_M)
+            .count()
+            .max(1) as f64;
+    Some(ProfileToe {
+        xyz: [
+            centre[0] + a * along[0] + toe * n[0],
+            centre[1] + a * along[1] + toe * n[1],
+            z0 + road(toe),
+        ],
+        step_m: step.max(0.0),
     })
 }

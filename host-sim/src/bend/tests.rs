@@ -616,3 +616,58 @@ fn timing_300_m() {
     );
     assert_eq!(edges.len(), 2);
 }
+
+/// A curb cut with no lip at the end of the drive, from s = 22 m on the left: the toe is
+/// only the break of slope between the flat road and a 20 % ramp behind it, ρ has no peak
+/// and the core gives no candidate there, and no track waits past the cut to bridge to.
+/// The track along the curb follows the break to the end of the scanned stretch (the left
+/// toe is seen up to s = 34.81 m); without cut following it stops within a few gap steps of
+/// the cut's start.
+#[test]
+fn a_curb_cut_without_lip_is_followed_to_the_end_of_the_drive() {
+    fn cut_at_end(s: f64) -> Option<(f64, f64, f64)> {
+        if s >= 22.0 {
+            Some((5.0, 0.0, 0.0))
+        } else {
+            Some((5.0, 0.15, 90.0))
+        }
+    }
+    let mut sc = make_scene(&SceneCfg {
+        left: cut_at_end,
+        ..straight(6)
+    });
+    // The ramp behind the toe (the road heads east: x = X0 + s, y = Y0 + u).
+    for i in 0..sc.x.len() {
+        let (s, u) = (sc.x[i] - X0, sc.y[i] - Y0);
+        if s >= 22.0 && u > 5.0 {
+            sc.z[i] += (0.2 * (u - 5.0)).min(0.15);
+        }
+    }
+    let x = sc.x.clone();
+    sc.candidates
+        .retain(|c| c.side == Side::Right || x[c.point as usize] - X0 < 22.0);
+    let reach = |edges: &[EdgeLine]| {
+        edges
+            .iter()
+            .filter(|e| e.side == Side::Left)
+            .flat_map(|e| e.points.iter().map(|p| p[0] - X0))
+            .fold(f64::MIN, f64::max)
+    };
+    let off = BendParams {
+        cut_follow_max_m: 0.0,
+        ..BendParams::default()
+    };
+    let without = extract_edges(&sc.input(), &off);
+    assert!(
+        reach(&without) < 23.5,
+        "without: to s = {}",
+        reach(&without)
+    );
+    let with = extract_edges(&sc.input(), &BendParams::default());
+    assert!(reach(&with) > 33.5, "with: to s = {}", reach(&with));
+    for e in with.iter().filter(|e| e.side == Side::Left) {
+        for &p in &e.points {
+            assert!(dist_to_toe(&sc, Side::Left, p) < 0.05, "{p:?} off the toe");
+        }
+    }
+}

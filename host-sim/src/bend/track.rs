@@ -11,7 +11,7 @@
 use super::claims::{Claims, Join};
 use super::grid::PointGrid;
 use super::params::BendParams;
-use super::profile::{profile_toe, usable, ProfileToe};
+use super::profile::{cut_toe, profile_toe, usable, ProfileToe};
 use super::seed::Seed;
 use super::BendInput;
 use crate::model::Side;
@@ -230,6 +230,15 @@ const TURN_EMA: f64 = 0.2;
 /// profile is asked instead, metres: 0.15 m apart on a 10 % grade they differ by 15 mm.
 const MAX_TOE_DZ_M: f64 = 0.04;
 
+/// Vertices a track must have before it may follow a curb cut's toe
+/// (`profile::cut_toe`): 1.5 m of curb, so that the break of slope is only ever followed
+/// along a line already tracked.
+const CUT_MIN_TRACK_STEPS: usize = 10;
+
+/// Shortest run on curb-cut toes kept at the end of a track, metres (see
+/// [`track_one_way`]): a third of the shortest cut.
+const CUT_MIN_KEEP_M: f64 = 1.0;
+
 /// Largest vertical component of the search direction (a grade of about 15 %).
 const MAX_CLIMB: f64 = 0.15;
 
@@ -285,6 +294,10 @@ fn track_one_way(
     let stop_rho = params.stop_rho_deg;
     let d_s = params.search_distance_m;
     let mut set: Vec<usize> = Vec::new();
+    // Length followed on curb-cut toes since the last toe with ρ or a step, metres.
+    let mut cut_run_m = 0.0f64;
+    // Index in `picked` of the first vertex of that run.
+    let mut cut_from: Option<usize> = None;
 
     for _ in 0..params.max_steps {
         // The search position (Fig. 7): one search distance ahead along v.
@@ -333,8 +346,29 @@ fn track_one_way(
                 // profile twice as long is tried where the short one shows no toe.
                 let c = [pred[0], pred[1], cur[2]];
                 let l = params.profile_half_length_m;
-                profile_toe(input, grid, c, along, up, l, params)
-                    .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params))
+                let toe = profile_toe(input, grid, c, along, up, l, params)
+                    .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params));
+                // Neither ρ nor a step: a curb cut's toe continues the curb's line as a
+                // break of slope, followed for at most `cut_follow_max_m`, and only by a
+                // track that has followed a curb before it.
+                let cut_ok = cut_run_m + d_s <= params.cut_follow_max_m
+                    && picked.len() >= CUT_MIN_TRACK_STEPS;
+                match toe {
+                    Some(t) => {
+                        cut_run_m = 0.0;
+                        cut_from = None;
+                        Some(t)
+                    }
+                    None if cut_ok => {
+                        let t = cut_toe(input, grid, c, along, up, 2.0 * l, params);
+                        if t.is_some() {
+                            cut_run_m += d_s;
+                            cut_from.get_or_insert(picked.len());
+                        }
+                        t
+                    }
+                    None => None,
+                }
             } else {
                 None
             };
@@ -395,6 +429,8 @@ fn track_one_way(
                 }
             }
             let Some((_, n)) = best else { break };
+            cut_run_m = 0.0;
+            cut_from = None;
             // Consecutive toes lie at nearly one height; a pick well above or below the
             // last vertex is on the curb face or top (far from the scanner, where ρ is
             // noisy), so the virtual profile's toe is taken instead when there is one.
@@ -448,6 +484,12 @@ fn track_one_way(
         own_pts.insert(n);
         cur = p;
         gap = 0;
+    }
+    // A short run on curb-cut toes that the track ends in is a few breaks of slope the
+    // prediction happened to meet, not a cut followed: it is dropped, so that the track
+    // ends where the curb did (and its end's tangent, which a bridge reads, is the curb's).
+    if let Some(k) = cut_from.filter(|_| cut_run_m < CUT_MIN_KEEP_M) {
+        picked.truncate(k);
     }
     (picked, None)
 }
