@@ -360,18 +360,9 @@ pub fn rough_segmentation(
                     if in_set[i] {
                         continue;
                     }
-                    let Some((s, d)) = position_of(i) else {
-                        continue;
-                    };
-                    let lo = line.partition_point(|q| q.0 < s - 0.5 * window);
-                    let hi = line.partition_point(|q| q.0 <= s + 0.5 * window);
-                    let mut offs: Vec<f64> = line[lo..hi].iter().map(|q| q.1).collect();
-                    if offs.is_empty() {
-                        continue;
-                    }
-                    let mid = offs.len() / 2;
-                    let (_, m, _) = offs.select_nth_unstable_by(mid, f64::total_cmp);
-                    if (d.abs() - *m).abs() <= corridor {
+                    if position_of(i)
+                        .is_some_and(|(s, d)| along_line(&line, s, d.abs(), corridor, window))
+                    {
                         in_set[i] = true;
                         out.candidates.push(i);
                     }
@@ -381,6 +372,21 @@ pub fn rough_segmentation(
     }
     out.candidates.sort_unstable();
     out
+}
+
+/// Whether a point at station `s` and offset `d` (absolute) lies within `corridor` of
+/// the median offset of `line` (station, offset; in station order) over `window` of
+/// station centred on `s`; `false` where the window holds no part of the line.
+fn along_line(line: &[(f64, f64)], s: f64, d: f64, corridor: f64, window: f64) -> bool {
+    let lo = line.partition_point(|q| q.0 < s - 0.5 * window);
+    let hi = line.partition_point(|q| q.0 <= s + 0.5 * window);
+    let mut offs: Vec<f64> = line[lo..hi].iter().map(|q| q.1).collect();
+    if offs.is_empty() {
+        return false;
+    }
+    let mid = offs.len() / 2;
+    let (_, m, _) = offs.select_nth_unstable_by(mid, f64::total_cmp);
+    (d - *m).abs() <= corridor
 }
 
 /// The innermost offset (absolute) of `cand` per [`ENERGY_BIN_M`] of station, as
@@ -496,6 +502,26 @@ mod tests {
             vec![0]
         );
         assert!(candidate_edge_points(&pts, &z, &rough, &refined, 0.1, 0.02).is_empty());
+    }
+
+    /// The smaller βs' candidates join along the chosen set's innermost line: in the
+    /// middle of a 10 m curb cut (no line there) the curb's line on either side still
+    /// places the corridor, so the lip's points (0.05 m off the line) join and road noise
+    /// (3 m nearer the vehicle) or a wall (1 m behind) does not; a stretch with no line
+    /// within half the window takes nothing.
+    #[test]
+    fn smaller_betas_join_along_the_chosen_line_across_a_cut() {
+        let line: Vec<(f64, f64)> = (0..80)
+            .map(|k| k as f64 * 0.5)
+            .filter(|s| !(15.0..25.0).contains(s))
+            .map(|s| (s, 5.0))
+            .collect();
+        assert!(along_line(&line, 20.0, 5.05, 0.3, 20.0));
+        assert!(!along_line(&line, 20.0, 2.0, 0.3, 20.0));
+        assert!(!along_line(&line, 20.0, 6.0, 0.3, 20.0));
+        assert!(!along_line(&line, 70.0, 5.0, 0.3, 20.0));
+        // A window shorter than the cut finds no line in its middle.
+        assert!(!along_line(&line, 20.0, 5.05, 0.3, 5.0));
     }
 
     #[test]
