@@ -191,9 +191,13 @@ pub fn extract(
     })
 }
 
+/// What a core stage counted: its counters, points dropped before / after the trajectory,
+/// points kept, the time span read.
+type StageTotals = (ReplayCounters, (u64, u64), u64, Option<(f64, f64)>);
+
 /// The core stage: scanlines of a profiler, or rings of a spinning sensor.
 enum Stage<'a> {
-    Lines(core_stage::CoreStage<'a>),
+    Lines(Box<core_stage::CoreStage<'a>>),
     Rings(Box<ring_stage::RingStage<'a>>),
 }
 
@@ -216,7 +220,7 @@ impl Stage<'_> {
     }
 
     /// Counters, points dropped before / after the trajectory, points kept, time span.
-    fn totals(&self) -> (ReplayCounters, (u64, u64), u64, Option<(f64, f64)>) {
+    fn totals(&self) -> StageTotals {
         match self {
             Stage::Lines(s) => (s.counters, s.dropped, s.points, s.time_span),
             Stage::Rings(s) => (s.counters, s.dropped, s.points, s.time_span),
@@ -236,7 +240,7 @@ impl SourceSpec {
             SourceSpec::Files(inputs, read) => {
                 Source::Files(Box::new(Campaign::open(&inputs, &read)?))
             }
-            SourceSpec::Sorted(runs, info) => Source::Sorted(runs, info),
+            SourceSpec::Sorted(runs, info) => Source::Sorted(runs, Box::new(info)),
         })
     }
 }
@@ -317,7 +321,9 @@ fn run_pass(
                         None,
                     )))
                 } else {
-                    Stage::Lines(core_stage::CoreStage::new(traj, *words, cfg.replay))
+                    Stage::Lines(Box::new(core_stage::CoreStage::new(
+                        traj, *words, cfg.replay,
+                    )))
                 };
                 let mut busy = 0.0;
                 for b in rx_b {
