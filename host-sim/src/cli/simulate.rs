@@ -1,8 +1,9 @@
-//! `curbtrace simulate --scene NAME -o DIR [--seed N] [--speed KMH]`: simulates a mobile
-//! laser scanning scene and writes `points.laz`, `trajectory.csv`, `reference.geojson`.
+//! `curbtrace simulate --scene NAME -o DIR [--seed N] [--speed KMH] [--sensor SENSOR]
+//! [--duration S]`: simulates a mobile laser scanning scene and writes `points.laz`,
+//! `trajectory.csv`, `reference.geojson` (docs/simulator.md).
 
 use anyhow::Context;
-use curbtrace_host_sim::simulate;
+use curbtrace_host_sim::simulate::{self, spinning::SpinSensor, SpinOutput};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 
@@ -22,21 +23,58 @@ pub struct Args {
     /// Vehicle speed in km/h (default: the scene's).
     #[arg(long)]
     pub speed: Option<f64>,
+    /// A spinning multi-beam lidar on the roof instead of the scene's profiler: vlp16,
+    /// hdl32, hdl64 or os1-64. The LAS carries each point's ring as an extra-bytes
+    /// dimension (docs/simulator.md).
+    #[arg(long)]
+    pub sensor: Option<String>,
+    /// Name of the ring dimension written with --sensor: ring, laser_id, channel, or none
+    /// (no ring dimension, as some converters write).
+    #[arg(long, default_value = "ring", requires = "sensor")]
+    pub ring_name: String,
+    /// Seconds of driving from the scene's start (default: the scene's whole drive).
+    #[arg(long)]
+    pub duration: Option<f64>,
 }
 
 /// Runs `curbtrace simulate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let spec = simulate::scene_for(&args.scene, args.seed)?;
+    let mut spec = simulate::scene_for(&args.scene, args.seed)?;
+    if let Some(d) = args.duration {
+        anyhow::ensure!(
+            d.is_finite() && d > 0.0,
+            "--duration {d}: seconds of driving must be positive"
+        );
+        // Road length at the nominal speed (the drive's speed varies by a few per cent).
+        let v = args.speed.unwrap_or(spec.speed_kmh) / 3.6;
+        spec.drive.1 = spec.drive.1.min(spec.drive.0 + d * v);
+    }
+    let sensor = match &args.sensor {
+        None => None,
+        Some(k) => Some(SpinSensor::by_key(k).with_context(|| {
+            let keys: Vec<&str> = SpinSensor::ALL.iter().map(|s| s.key).collect();
+            format!("unknown sensor {k:?}; valid sensors: {}", keys.join(", "))
+        })?),
+    };
+    let ring_name = match args.ring_name.as_str() {
+        "none" => None,
+        n @ ("ring" | "laser_id" | "channel") => Some(n),
+        n => anyhow::bail!("--ring-name {n:?}: one of ring, laser_id, channel, none"),
+    };
+    let spin = sensor
+        .as_ref()
+        .map(|sensor| SpinOutput { sensor, ring_name });
     if !spec.description.is_empty() {
         println!("{}", spec.description);
     }
     let progress = std::io::stderr().is_terminal();
-    let s = simulate::run(&spec, args.seed, args.speed, &args.out, progress)
+    let s = simulate::run_with(&spec, args.seed, args.speed, spin, &args.out, progress)
         .with_context(|| format!("simulating scene {}", args.scene))?;
     let [curb, cut, inter, bay] = s.reference_m;
     println!(
-        "{}: {} points, {} lines, {:.1} m driven in {:.1} s, reference {:.1} m (curb {:.1}, curb_cut {:.1}, intersection {:.1}, bus_bay {:.1}); {:.1} s wall ({:.1} s simulating, {:.1} s writing)",
+        "{}{}: {} points, {} lines, {:.1} m driven in {:.1} s, reference {:.1} m (curb {:.1}, curb_cut {:.1}, intersection {:.1}, bus_bay {:.1}); {:.1} s wall ({:.1} s simulating, {:.1} s writing)",
         s.scene,
+        sensor.map(|x| format!(" ({})", x.name)).unwrap_or_default(),
         s.points,
         s.lines,
         s.length_m,

@@ -12,6 +12,7 @@
 //! | [`prims`] | walls, fences, parked cars, poles, weeds, leaves, and the ray walk through them |
 //! | [`drive`] | the vehicle's path, speed and attitude → the 200 Hz trajectory |
 //! | [`scanner`] | the VQ-250-like profiler: pulse directions and timing, noise, intensity |
+//! | [`spinning`] | spinning multi-beam lidars (VLP-16, HDL-32E, HDL-64E, OS1-64) on the roof |
 //! | [`reference`](mod@reference) | the visibility rule and the reference lines |
 //! | [`write`](mod@write) | LAS 1.4 / LAZ and the trajectory CSV |
 //!
@@ -47,6 +48,7 @@ pub mod reference;
 pub mod scanner;
 pub mod scene;
 pub mod scenes;
+pub mod spinning;
 pub mod world;
 pub mod write;
 
@@ -193,6 +195,25 @@ pub fn simulate(
     speed_kmh: Option<f64>,
     progress: bool,
 ) -> Result<Simulation, SimError> {
+    simulate_with(spec, seed, speed_kmh, None, progress)
+}
+
+/// [`simulate`] with the scene's profiler, or with the spinning `sensor` on the roof
+/// instead (its revolutions are the simulation's lines).
+pub fn simulate_with(
+    spec: &SceneSpec,
+    seed: u64,
+    speed_kmh: Option<f64>,
+    sensor: Option<&spinning::SpinSensor>,
+    progress: bool,
+) -> Result<Simulation, SimError> {
+    let mut spec = spec.clone();
+    if let Some(s) = sensor {
+        // Whole revolutions cover the drive; the noise is the sensor's.
+        spec.scanner.line_rate_hz = s.rate_hz;
+        spec.scanner.range_sigma_m = s.range_sigma_m;
+    }
+    let spec = &spec;
     let speed = speed_kmh.unwrap_or(spec.speed_kmh);
     if !(speed.is_finite() && (1.0..=120.0).contains(&speed)) {
         return Err(SimError::BadParameter(format!(
@@ -201,6 +222,9 @@ pub fn simulate(
     }
     let world = World::build(spec.clone(), seed);
     let drive = drive::plan(&world, speed, seed);
+    if let Some(sensor) = sensor {
+        return Ok(simulate_revolutions(world, drive, sensor, seed, progress));
+    }
     let cfg = world.spec.scanner;
     let dirs = scanner::mount_directions(&cfg);
     let own: Vec<bool> = dirs
@@ -251,6 +275,58 @@ pub fn simulate(
     })
 }
 
+/// The revolutions of a spinning sensor over the drive, every one from its own generator
+/// seeded by `(seed, revolution)`, gathered in order.
+fn simulate_revolutions(
+    world: World,
+    drive: drive::Drive,
+    sensor: &spinning::SpinSensor,
+    seed: u64,
+    progress: bool,
+) -> Simulation {
+    let revs = ((drive.scan.1 - drive.scan.0) * sensor.rate_hz).round() as usize;
+    let bar = progress.then(|| {
+        let b = indicatif::ProgressBar::new(revs as u64);
+        b.set_message(format!(
+            "simulating {} with {}",
+            world.spec.name, sensor.name
+        ));
+        b
+    });
+    let per_rev: Vec<Vec<scanner::Return>> = (0..revs)
+        .into_par_iter()
+        .map(|k| {
+            let mut rng = ChaCha8Rng::seed_from_u64(line_seed(seed, k as u64));
+            let t_rev = drive.scan.0 + k as f64 / sensor.rate_hz;
+            let r = spinning::cast_revolution(&world, &drive.traj, sensor, t_rev, &mut rng);
+            if let Some(b) = &bar {
+                b.inc(1);
+            }
+            r
+        })
+        .collect();
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let returns: Vec<scanner::Return> = per_rev.into_iter().flatten().collect();
+    let mut vis = reference::Visibility::new(&world.ground);
+    for r in &returns {
+        if let Some(tc) = &r.toe {
+            vis.add(tc);
+        }
+    }
+    let reference = reference::reference_lines(&world.ground, &vis, &drive.traj, world.spec.origin);
+    Simulation {
+        world,
+        returns,
+        traj: drive.traj,
+        reference,
+        lines: revs,
+        length_m: drive.length_m,
+        scan: drive.scan,
+    }
+}
+
 /// Simulates a scene and writes `points.laz`, `trajectory.csv` and `reference.geojson`
 /// into `out_dir` (created if missing).
 pub fn run(
@@ -260,18 +336,41 @@ pub fn run(
     out_dir: &Path,
     progress: bool,
 ) -> Result<SimSummary, SimError> {
+    run_with(spec, seed, speed_kmh, None, out_dir, progress)
+}
+
+/// How a spinning sensor's run is written: the sensor, and the name of the ring's
+/// extra-bytes dimension (`None`: no ring dimension, as some converters write).
+#[derive(Clone, Copy, Debug)]
+pub struct SpinOutput<'a> {
+    /// The sensor.
+    pub sensor: &'a spinning::SpinSensor,
+    /// `ring`, `laser_id`, `channel`, or `None`.
+    pub ring_name: Option<&'a str>,
+}
+
+/// [`run`] with the scene's profiler or a spinning sensor (`spin`).
+pub fn run_with(
+    spec: &SceneSpec,
+    seed: u64,
+    speed_kmh: Option<f64>,
+    spin: Option<SpinOutput<'_>>,
+    out_dir: &Path,
+    progress: bool,
+) -> Result<SimSummary, SimError> {
     let start = Instant::now();
     std::fs::create_dir_all(out_dir).map_err(|source| SimError::Io {
         path: out_dir.display().to_string(),
         source,
     })?;
-    let sim = simulate(spec, seed, speed_kmh, progress)?;
+    let sim = simulate_with(spec, seed, speed_kmh, spin.map(|s| s.sensor), progress)?;
     let simulate_s = start.elapsed().as_secs_f64();
     let origin = sim.world.spec.origin;
     let points_path = out_dir.join("points.laz");
     let trajectory_path = out_dir.join("trajectory.csv");
     let reference_path = out_dir.join("reference.geojson");
-    write::write_points(&points_path, &sim.returns, origin, spec.epsg)?;
+    let ring = spin.and_then(|s| s.ring_name);
+    write::write_points_with(&points_path, &sim.returns, origin, spec.epsg, ring)?;
     write::write_trajectory(&trajectory_path, &sim.traj, origin)?;
     // The same CRS text as the LAS file's WKT VLR, so that readers deriving the CRS from
     // the points and from the reference get identical values.

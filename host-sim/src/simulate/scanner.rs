@@ -127,6 +127,8 @@ pub struct Return {
     pub scan_angle_deg: f64,
     /// For ground hits near a curb toe: where the *true* hit lies relative to the toe.
     pub toe: Option<ToeCoord>,
+    /// The laser's ring (0 = lowest beam) of a spinning sensor; 0 for the profiler.
+    pub ring: u16,
 }
 
 /// Casts every pulse of line `k` (first pulse at `t_line`) and returns its returns in
@@ -159,12 +161,15 @@ pub fn cast_line<R: Rng>(
             intensity: ret.1,
             scan_angle_deg: scan_angle_deg(cfg, j),
             toe: ret.2,
+            ring: 0,
         });
     }
     out
 }
 
-fn cast_pulse<R: Rng>(
+/// Casts one pulse from `pose` along the body-frame direction `db`: the first surface hit
+/// with range noise, its intensity and, for ground hits near a toe, the toe coordinates.
+pub(super) fn cast_pulse<R: Rng>(
     world: &World,
     pose: &Pose,
     db: [f64; 3],

@@ -47,12 +47,44 @@ pub fn write_points(
     origin: [f64; 3],
     epsg: u32,
 ) -> Result<(), SimError> {
+    write_points_with(path, returns, origin, epsg, None)
+}
+
+/// The Extra Bytes VLR (LAS 1.4 R15 §2.5.7.2) describing one `u16` dimension named `name`.
+pub fn ring_vlr(name: &str) -> las::Vlr {
+    let mut d = vec![0u8; 192];
+    d[2] = 3; // data type: unsigned short
+    let n = name.as_bytes();
+    d[4..4 + n.len().min(32)].copy_from_slice(&n[..n.len().min(32)]);
+    let desc = b"laser ring, 0 = lowest beam";
+    d[160..160 + desc.len()].copy_from_slice(desc);
+    las::Vlr {
+        user_id: "LASF_Spec".into(),
+        record_id: 4,
+        description: "Extra Bytes".into(),
+        data: d,
+    }
+}
+
+/// [`write_points`], with each return's ring as a `u16` extra-bytes dimension named
+/// `ring_name` when given.
+pub fn write_points_with(
+    path: &Path,
+    returns: &[Return],
+    origin: [f64; 3],
+    epsg: u32,
+    ring_name: Option<&str>,
+) -> Result<(), SimError> {
     let err = |e: las::Error| SimError::Write {
         path: path.display().to_string(),
         what: e.to_string(),
     };
     let mut b = las::Builder::from(las::Version::new(1, 4));
     b.point_format = las::point::Format::new(6).map_err(err)?;
+    if let Some(name) = ring_name {
+        b.point_format.extra_bytes = 2;
+        b.vlrs.push(ring_vlr(name));
+    }
     b.generating_software = "curbtrace simulate".into();
     b.system_identifier = "curbtrace scene simulator".into();
     b.gps_time_type = las::GpsTimeType::Standard;
@@ -89,6 +121,11 @@ pub fn write_points(
         scan_angle: scan_angle_for_las(r.scan_angle_deg),
         point_source_id: 1,
         gps_time: Some(r.t),
+        extra_bytes: if ring_name.is_some() {
+            r.ring.to_le_bytes().to_vec()
+        } else {
+            Vec::new()
+        },
         ..Default::default()
     };
     // Slabs of a million points: the LAZ writer compresses a slab's chunks in parallel.

@@ -79,6 +79,9 @@ pub struct InputInfo {
     pub format: u8,
     /// LAZ.
     pub compressed: bool,
+    /// The name of the first file's ring dimension (a spinning sensor's file; every
+    /// point's channel key is its ring).
+    pub ring: Option<String>,
 }
 
 impl InputInfo {
@@ -130,6 +133,7 @@ impl Campaign {
         let mut no_crs = None;
         let (mut bytes, mut points) = (0u64, 0u64);
         let mut head = ((1, 2), 0, false);
+        let mut ring = None;
         for p in paths {
             let r = LasBatches::open(&p, opts)?;
             match &first {
@@ -137,6 +141,7 @@ impl Campaign {
                     first = Some((p.clone(), r.crs.clone()));
                     no_crs = r.no_crs;
                     head = (r.version, r.format, r.compressed);
+                    ring = r.ring.as_ref().map(|d| d.name.clone());
                 }
                 Some((fp, fc)) => {
                     let same = match (fc, &r.crs) {
@@ -172,6 +177,7 @@ impl Campaign {
                 version: head.0,
                 format: head.1,
                 compressed: head.2,
+                ring,
             },
             opts: *opts,
             next_file: 0,

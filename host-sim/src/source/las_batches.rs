@@ -17,6 +17,76 @@ use std::path::{Path, PathBuf};
 /// bytes; the slab is capped whatever the record length).
 const MAX_SLAB_BYTES: u64 = 64 << 20;
 
+/// Names of an extra-bytes dimension that holds a spinning sensor's ring (laser number),
+/// matched without regard to case.
+pub const RING_NAMES: [&str; 3] = ["ring", "laser_id", "channel"];
+
+/// A ring dimension found in the Extra Bytes VLR: where it sits in the point record.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RingDim {
+    /// Its name as the file spells it.
+    pub name: String,
+    /// Byte offset in the point record.
+    pub at: usize,
+    /// LAS data type (1–8: unsigned and signed integers of 1, 2, 4, 8 bytes).
+    pub data_type: u8,
+}
+
+impl RingDim {
+    /// The dimension named ring, laser_id or channel among the Extra Bytes VLR's
+    /// descriptors (LAS 1.4 R15 §2.5.7.2, 192 bytes each, the values in order after the
+    /// format's own `base_len` bytes). `None` when there is none, or when a descriptor
+    /// before it has a type whose size is not known (deprecated array types).
+    pub fn find(header: &las::Header, base_len: usize) -> Option<Self> {
+        let vlr = header
+            .all_vlrs()
+            .find(|v| v.user_id.trim_end_matches('\0') == "LASF_Spec" && v.record_id == 4)?;
+        let mut at = base_len;
+        for d in vlr.data.chunks_exact(192) {
+            let (data_type, options) = (d[2], d[3]);
+            let size = match data_type {
+                0 => usize::from(options),
+                1 | 2 => 1,
+                3 | 4 => 2,
+                5 | 6 | 9 => 4,
+                7 | 8 | 10 => 8,
+                _ => return None,
+            };
+            let name: String = String::from_utf8_lossy(&d[4..36])
+                .trim_end_matches('\0')
+                .trim()
+                .to_string();
+            if (1..=8).contains(&data_type)
+                && RING_NAMES.iter().any(|n| name.eq_ignore_ascii_case(n))
+            {
+                return Some(Self {
+                    name,
+                    at,
+                    data_type,
+                });
+            }
+            at += size;
+        }
+        None
+    }
+
+    /// The ring of one point record; `None` when it is outside 0–255.
+    #[inline]
+    pub fn read(&self, rec: &[u8]) -> Option<u8> {
+        let b = rec.get(self.at..)?;
+        let v: i64 = match self.data_type {
+            1 => i64::from(b[0]),
+            2 => i64::from(b[0] as i8),
+            3 => i64::from(u16::from_le_bytes([b[0], b[1]])),
+            4 => i64::from(i16::from_le_bytes([b[0], b[1]])),
+            5 => i64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+            6 => i64::from(i32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+            _ => i64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]),
+        };
+        u8::try_from(v).ok()
+    }
+}
+
 /// A file open for batch reading.
 pub struct LasBatches {
     path: PathBuf,
@@ -42,6 +112,9 @@ pub struct LasBatches {
     pub format: u8,
     /// LAZ-compressed.
     pub compressed: bool,
+    /// The ring dimension of a spinning sensor's file: when present, every point's channel
+    /// key is its ring (docs/spec.md, *Spinning sensors*).
+    pub ring: Option<RingDim>,
 }
 
 impl LasBatches {
@@ -67,7 +140,11 @@ impl LasBatches {
         let record_len = pd.record_len();
         let extended = header.point_format().is_extended;
         let slab = (MAX_SLAB_BYTES / record_len.max(1) as u64).clamp(1, super::BATCH_POINTS as u64);
+        let base_len = record_len.saturating_sub(usize::from(header.point_format().extra_bytes));
+        let ring = RingDim::find(&header, base_len)
+            .filter(|r| r.at + [0, 1, 1, 2, 2, 4, 4, 8, 8][usize::from(r.data_type)] <= record_len);
         Ok(Self {
+            ring,
             path: path.to_path_buf(),
             crs: las_in::header_crs(&header).ok(),
             no_crs: las_in::header_crs(&header).err(),
@@ -216,6 +293,11 @@ impl LasBatches {
             }
         };
         let from = out.len();
+        let ring = self.ring.clone();
+        let key = |rec: &[u8]| match &ring {
+            Some(r) => r.read(rec).unwrap_or(u8::MAX),
+            None => channel_of(rec),
+        };
         if sel == ScannerSelection::All {
             // Every record kept: one tight pass per column.
             let recs = || raw.chunks_exact(rl);
@@ -225,7 +307,7 @@ impl LasBatches {
             out.t.extend(recs().map(|r| f64_at(r, gps_at)));
             out.intensity.extend(recs().map(|r| u16_at(r, 12)));
             out.scan_angle_deg.extend(recs().map(angle));
-            out.channel.extend(recs().map(channel_of));
+            out.channel.extend(recs().map(key));
         } else {
             for rec in raw.chunks_exact(rl) {
                 let keep = match sel {
@@ -241,10 +323,23 @@ impl LasBatches {
                         f64_at(rec, gps_at),
                         u16_at(rec, 12),
                         angle(rec),
-                        channel_of(rec),
+                        key(rec),
                     );
                 }
             }
+        }
+        if let (Some(r), Some(k)) = (
+            &ring,
+            out.channel[from..].iter().position(|&c| c == u8::MAX),
+        ) {
+            return Err(LasError::NoPoints {
+                path: self.path.clone(),
+                what: format!(
+                    "point {}: extra-bytes dimension {:?} is not a ring number 0–254",
+                    self.done + k as u64,
+                    r.name
+                ),
+            });
         }
         if let Some(k) = out.t[from..].iter().position(|t| !t.is_finite()) {
             // The index in the file: kept records before it, plus the skipped ones.

@@ -33,7 +33,7 @@ pub enum Source {
     /// Files in time order.
     Files(Box<Campaign>),
     /// Files sorted through a temporary directory.
-    Sorted(SortedRuns, InputInfo),
+    Sorted(SortedRuns, Box<InputInfo>),
 }
 
 impl Source {

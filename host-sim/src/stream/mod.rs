@@ -13,6 +13,8 @@
 //! and the run starts again on a chunk-wise external sort (see `source::external_sort`).
 //!
 //! - [`core_stage`] — the core stage (batches cut at line starts).
+//! - [`ring_stage`] — the core stage of a spinning sensor's file (every ring a channel,
+//!   every half revolution of a ring a scanline).
 //! - [`window`] — sections along the route, the bend method per window.
 //! - [`merge`] — joining pieces at section boundaries.
 //! - [`tasks`] — the campaign cut into independent tasks of whole sections, merged after.
@@ -20,6 +22,7 @@
 pub mod core_stage;
 pub mod malloc;
 pub mod merge;
+pub mod ring_stage;
 pub mod tasks;
 pub mod window;
 
@@ -85,10 +88,39 @@ pub fn extract(
     let read = ReadOptions {
         scanner: opts.scanner,
     };
-    let campaign = Campaign::open(inputs, &read).map_err(ExtractError::Source)?;
+    let mut campaign = Campaign::open(inputs, &read).map_err(ExtractError::Source)?;
     let info = campaign.info().clone();
-    drop(campaign);
     let first = info.files.first().cloned().unwrap_or_default();
+    if info.ring.is_none() {
+        // A spinning sensor's points without their ring cannot be cut into scanlines.
+        if let Some(b) = campaign
+            .next_batch(STREAM_BATCH_POINTS)
+            .map_err(ExtractError::Source)?
+        {
+            if ring_stage::looks_spinning(&b, &traj) {
+                return Err(ExtractError::Stream {
+                    path: first,
+                    what: format!(
+                        "the points look like a spinning multi-beam lidar's (many beams fired at once) but carry no ring: add the laser number as an extra-bytes dimension named {} (docs/spec.md, Spinning sensors)",
+                        crate::source::las_batches::RING_NAMES.join(", ")
+                    ),
+                });
+            }
+        }
+    }
+    drop(campaign);
+    let rings = info.ring.is_some();
+    // Curbs within the arcs' reach ahead and behind are seen from the vehicle's stations
+    // that far away: the window holds that much more road.
+    let window = &WindowParams {
+        margin_m: window.margin_m
+            + if rings {
+                f64::from(crate::rings::ArcParams::default().max_reach_m)
+            } else {
+                0.0
+            },
+        ..*window
+    };
     let mut sorted: Option<SortedRuns> = None;
     let mut reordered = false;
     let pass = loop {
@@ -97,7 +129,9 @@ pub fn extract(
             Some(runs) => SourceSpec::Sorted(runs, info.clone()),
             None => SourceSpec::Files(inputs.to_vec(), read),
         };
-        match run_pass(spec, &traj, &words, cfg, window, progress, info.bytes) {
+        match run_pass(
+            spec, &traj, &words, cfg, window, progress, info.bytes, rings,
+        ) {
             Ok((pass, sel)) => break (pass, sel),
             Err(PassError::Source(SourceError::OutOfOrder { .. })) if !reordered => {
                 // Start again on the sorted runs.
@@ -157,6 +191,43 @@ pub fn extract(
     })
 }
 
+/// What a core stage counted: its counters, points dropped before / after the trajectory,
+/// points kept, the time span read.
+type StageTotals = (ReplayCounters, (u64, u64), u64, Option<(f64, f64)>);
+
+/// The core stage: scanlines of a profiler, or rings of a spinning sensor.
+enum Stage<'a> {
+    Lines(Box<core_stage::CoreStage<'a>>),
+    Rings(Box<ring_stage::RingStage<'a>>),
+}
+
+impl Stage<'_> {
+    fn push(
+        &mut self,
+        b: PointBatch,
+    ) -> Result<Option<core_stage::CoreBatch>, core_stage::CoreError> {
+        match self {
+            Stage::Lines(s) => s.push(b),
+            Stage::Rings(s) => s.push(b),
+        }
+    }
+
+    fn finish(&mut self) -> Result<Option<core_stage::CoreBatch>, core_stage::CoreError> {
+        match self {
+            Stage::Lines(s) => s.finish(),
+            Stage::Rings(s) => s.finish(),
+        }
+    }
+
+    /// Counters, points dropped before / after the trajectory, points kept, time span.
+    fn totals(&self) -> StageTotals {
+        match self {
+            Stage::Lines(s) => (s.counters, s.dropped, s.points, s.time_span),
+            Stage::Rings(s) => (s.counters, s.dropped, s.points, s.time_span),
+        }
+    }
+}
+
 /// What the reader thread opens.
 enum SourceSpec {
     Files(Vec<PathBuf>, ReadOptions),
@@ -169,7 +240,7 @@ impl SourceSpec {
             SourceSpec::Files(inputs, read) => {
                 Source::Files(Box::new(Campaign::open(&inputs, &read)?))
             }
-            SourceSpec::Sorted(runs, info) => Source::Sorted(runs, info),
+            SourceSpec::Sorted(runs, info) => Source::Sorted(runs, Box::new(info)),
         })
     }
 }
@@ -187,6 +258,7 @@ const READ_THREADS: &str = "ct-read";
 /// [`READ_THREADS`] when the stream named them), the
 /// edges' this thread's while it tracks, the core's the rest of the process's during the
 /// pass (the core thread and the pools it starts per batch).
+#[allow(clippy::too_many_arguments)]
 fn run_pass(
     spec: SourceSpec,
     traj: &Trajectory,
@@ -195,6 +267,7 @@ fn run_pass(
     window: &WindowParams,
     progress: &Progress,
     bytes_total: u64,
+    rings: bool,
 ) -> Result<(Pass, crate::io::las_in::ScannerSelection), PassError> {
     progress.stage_bytes("extract", bytes_total);
     let cpu0 = process_cpu_s();
@@ -241,7 +314,17 @@ fn run_pass(
         let core = std::thread::Builder::new()
             .name("ct-core".into())
             .spawn_scoped(s, move || {
-                let mut stage = core_stage::CoreStage::new(traj, *words, cfg.replay);
+                let mut stage = if rings {
+                    Stage::Rings(Box::new(ring_stage::RingStage::new(
+                        traj,
+                        crate::rings::ArcParams::default(),
+                        None,
+                    )))
+                } else {
+                    Stage::Lines(Box::new(core_stage::CoreStage::new(
+                        traj, *words, cfg.replay,
+                    )))
+                };
                 let mut busy = 0.0;
                 for b in rx_b {
                     let b = match b {
@@ -280,7 +363,7 @@ fn run_pass(
                 }
                 busy += t0.elapsed().as_secs_f64();
                 core_s.store(busy.to_bits(), Ordering::Relaxed);
-                Some((stage.counters, stage.dropped, stage.points, stage.time_span))
+                Some(stage.totals())
             })
             .expect("the core thread starts");
         let mut win = window::SectionWindow::new(traj, *window, cfg.bend.clone());

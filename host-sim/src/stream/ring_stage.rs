@@ -1,0 +1,701 @@
+//! The core stage for spinning multi-beam lidars (docs/spec.md, *Spinning sensors*): every
+//! ring is a channel of its own, every half revolution of a ring a scanline.
+//!
+//! 1. Each point is brought into the vehicle frame of its own time (forward, left, up from
+//!    the trajectory's origin and heading at t): x_b, y_b, z_b. The projection to the
+//!    kernel's plane is the profiler's, x′ = y_b, z′ = z_b ([`crate::rings::project`]).
+//! 2. Per ring, in time order, the points form runs of one half (front: x_b ≥ 0, rear:
+//!    x_b < 0); a run ends when the half changes or the ring is silent for a quarter
+//!    revolution. A run is a half-arc ([`crate::rings::arc`]'s rule, cut in time instead
+//!    of per frame): points nearer than `min_range_m`, farther than `max_lateral_m` to the
+//!    side, or piled up closer than `min_separation_m` in x′–z′ are left out, and arcs that
+//!    do not see the road at the centre line or reach farther than `max_reach_m` are
+//!    skipped.
+//! 3. The arcs run through the core, one line each, with the sensor's kernel parameters
+//!    ([`crate::rings::SensorModel::kernel_params`], the azimuth step and rate estimated
+//!    from the first points: [`estimate_sensor`]).
+//! 4. The output is a [`CoreBatch`] in stream order, as for profilers: world coordinates,
+//!    ρ and status per point (`None` for points left out), the arc's number as the
+//!    scanline, the candidates. The window, tracker and merge downstream are the
+//!    profilers'.
+//!
+//! A batch is cut before the earliest run still open, so no arc is split between batches.
+
+use super::core_stage::{CoreBatch, CoreError};
+use crate::io::trajectory::Trajectory;
+use crate::model::Side;
+use crate::replay::project::PoseCursor;
+use crate::replay::run::{ReplayCounters, ReplayError};
+use crate::replay::{Candidate, PointStatus};
+use crate::rings::{project, ArcCounters, ArcParams, SensorModel};
+use crate::source::PointBatch;
+use curbtrace_core::kernel::{KernelParams, ScanlineOutput};
+use curbtrace_core::wire::{PointRecord, StreamEncoder, MAX_PACKET_LEN, MAX_POINTS_PER_PACKET};
+use curbtrace_core::Pipeline;
+
+/// Longest half-arc the core holds; more points are counted as truncated. A half
+/// revolution of one laser is 512–1 100 points on the sensors of docs/simulator.md.
+pub const ARC_CAPACITY: usize = 4096;
+/// The pipeline the arcs run through.
+type ArcPipeline = Pipeline<{ 1 << 16 }, ARC_CAPACITY>;
+
+/// Points of the first batches the sensor's azimuth step and rate are estimated from.
+const ESTIMATE_POINTS: usize = 20_000;
+
+/// Median angular speed of the beam between consecutive returns above which a stream is a
+/// multi-beam sensor's, degrees per second (`looks_spinning`): a profiler's mirror turns
+/// at most 2.5 · 10⁵ °/s (250 lines/s), consecutive lasers of a spinning head are one to
+/// tens of degrees apart within microseconds (10⁶–10⁷ °/s) or fire at the same instant.
+const SPINNING_DEG_PER_S: f64 = 1.0e6;
+
+/// One point in the vehicle frame of its time.
+#[derive(Clone, Copy)]
+struct Body {
+    x: f32,
+    y: f32,
+    z: f32,
+}
+
+fn body_of(cur: &mut PoseCursor<'_>, x: f64, y: f64, z: f64, t: f64) -> Option<Body> {
+    let (q, l) = cur.frame_at(t)?;
+    let (dx, dy) = (x - q[0], y - q[1]);
+    Some(Body {
+        x: (dx * l[1] - dy * l[0]) as f32,
+        y: (dx * l[0] + dy * l[1]) as f32,
+        z: (z - q[2]) as f32,
+    })
+}
+
+/// Whether the points of `b` come from a spinning multi-beam sensor (module constant
+/// [`SPINNING_DEG_PER_S`]): the median angle between the directions of consecutive
+/// returns, seen from the trajectory's origin at their times, per second between them.
+pub fn looks_spinning(b: &PointBatch, traj: &Trajectory) -> bool {
+    let mut cur = PoseCursor::new(traj);
+    let n = b.len().min(ESTIMATE_POINTS);
+    let mut speeds = Vec::with_capacity(n);
+    let mut prev: Option<([f64; 3], f64)> = None;
+    for i in 0..n {
+        let Some(p) = body_of(&mut cur, b.x[i], b.y[i], b.z[i], b.t[i]) else {
+            prev = None;
+            continue;
+        };
+        let v = [f64::from(p.x), f64::from(p.y), f64::from(p.z)];
+        let r = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if r < 0.5 {
+            continue;
+        }
+        let u = [v[0] / r, v[1] / r, v[2] / r];
+        if let Some((w, t0)) = prev {
+            let c = (u[0] * w[0] + u[1] * w[1] + u[2] * w[2]).clamp(-1.0, 1.0);
+            let ang = c.acos().to_degrees();
+            let dt = b.t[i] - t0;
+            speeds.push(if dt > 0.0 {
+                ang / dt
+            } else if ang > 0.1 {
+                f64::INFINITY
+            } else {
+                0.0
+            });
+        }
+        prev = Some((u, b.t[i]));
+    }
+    if speeds.len() < 100 {
+        return false;
+    }
+    let m = speeds.len() / 2;
+    *speeds.select_nth_unstable_by(m, f64::total_cmp).1 > SPINNING_DEG_PER_S
+}
+
+/// The sensor's azimuth step (median azimuth between consecutive points of one ring less
+/// than 2 ms apart) and rate (median azimuth speed over those pairs), and its ring count;
+/// `None` with fewer than 100 such pairs.
+pub fn estimate_sensor(b: &PointBatch, traj: &Trajectory) -> Option<SensorModel> {
+    let mut cur = PoseCursor::new(traj);
+    let mut last: Vec<Option<(f64, f64)>> = vec![None; 256];
+    let (mut steps, mut speeds) = (Vec::new(), Vec::new());
+    let mut rings = 0u16;
+    for i in 0..b.len().min(4 * ESTIMATE_POINTS) {
+        let Some(p) = body_of(&mut cur, b.x[i], b.y[i], b.z[i], b.t[i]) else {
+            continue;
+        };
+        let ring = usize::from(b.channel[i]);
+        rings = rings.max(ring as u16 + 1);
+        let az = f64::from(p.y).atan2(f64::from(p.x)).to_degrees();
+        if let Some((a0, t0)) = last[ring] {
+            let d = (az - a0 + 540.0).rem_euclid(360.0) - 180.0;
+            let dt = b.t[i] - t0;
+            if dt > 0.0 && dt < 2e-3 && d.abs() > 1e-3 && d.abs() < 5.0 {
+                steps.push(d.abs());
+                speeds.push(d.abs() / dt);
+            }
+        }
+        last[ring] = Some((az, b.t[i]));
+    }
+    if steps.len() < 100 {
+        return None;
+    }
+    let med = |v: &mut Vec<f64>| {
+        let m = v.len() / 2;
+        *v.select_nth_unstable_by(m, f64::total_cmp).1
+    };
+    let step = med(&mut steps);
+    let rate = med(&mut speeds) / 360.0;
+    Some(SensorModel {
+        name: "spinning lidar",
+        rings,
+        rate_hz: rate as f32,
+        azimuth_step_deg: step as f32,
+    })
+}
+
+/// A run of one ring in one half, as indices into the carried points.
+struct Run {
+    front: bool,
+    points: Vec<u32>,
+    last_t: f64,
+}
+
+/// The ring stage's state between batches.
+pub struct RingStage<'a> {
+    traj: &'a Trajectory,
+    arc: ArcParams,
+    kernel: Option<KernelParams>,
+    sensor: Option<SensorModel>,
+    t_range: (f64, f64),
+    carry: PointBatch,
+    /// The vehicle-frame coordinates of the first carried points (computed once).
+    body: Vec<Body>,
+    next_base: u64,
+    lines: u32,
+    pipe: Box<ArcPipeline>,
+    /// Counters summed over the stream.
+    pub counters: ReplayCounters,
+    /// The half-arc cut's counters summed over the stream.
+    pub arcs: ArcCounters,
+    /// Points before / after the trajectory.
+    pub dropped: (u64, u64),
+    /// Points kept.
+    pub points: u64,
+    /// Times of the first and the last point read, before the trajectory's cut.
+    pub time_span: Option<(f64, f64)>,
+}
+
+impl<'a> RingStage<'a> {
+    /// A stage for `traj`; `kernel` overrides the sensor's parameters.
+    pub fn new(traj: &'a Trajectory, arc: ArcParams, kernel: Option<KernelParams>) -> Self {
+        Self {
+            traj,
+            arc,
+            kernel,
+            sensor: None,
+            t_range: traj
+                .time_range()
+                .unwrap_or((f64::INFINITY, f64::NEG_INFINITY)),
+            carry: PointBatch::default(),
+            body: Vec::new(),
+            next_base: 0,
+            lines: 0,
+            pipe: Box::new(ArcPipeline::new()),
+            counters: ReplayCounters::default(),
+            arcs: ArcCounters::default(),
+            dropped: (0, 0),
+            points: 0,
+            time_span: None,
+        }
+    }
+
+    /// The sensor estimated from the first points (or the fallback), once known.
+    pub fn sensor(&self) -> Option<SensorModel> {
+        self.sensor
+    }
+
+    /// Takes a batch; returns the core's output for the points of the arcs it completes.
+    pub fn push(&mut self, b: PointBatch) -> Result<Option<CoreBatch>, CoreError> {
+        if let (Some(&first), Some(&last)) = (b.t.first(), b.t.last()) {
+            let (a, z) = self.time_span.get_or_insert((first, last));
+            *a = a.min(first);
+            *z = z.max(last);
+        }
+        let (t0, t1) = self.t_range;
+        let lo = b.t.partition_point(|&t| t < t0);
+        let hi = b.t.partition_point(|&t| t <= t1).max(lo);
+        self.dropped.0 += lo as u64;
+        self.dropped.1 += (b.len() - hi) as u64;
+        self.carry.extend_from(&b, lo..hi);
+        if self.sensor.is_none() {
+            if self.carry.len() < ESTIMATE_POINTS {
+                return Ok(None);
+            }
+            self.sensor = Some(self.estimate());
+        }
+        self.run(false)
+    }
+
+    /// Runs what is left at the end of the stream.
+    pub fn finish(&mut self) -> Result<Option<CoreBatch>, CoreError> {
+        if self.carry.is_empty() {
+            return Ok(None);
+        }
+        if self.sensor.is_none() {
+            self.sensor = Some(self.estimate());
+        }
+        self.run(true)
+    }
+
+    /// The sensor from the carried points; without enough of them, a 10 Hz sensor with
+    /// the coarsest step of docs/simulator.md's sensors (0.35°, so d_b errs towards
+    /// having neighbours).
+    fn estimate(&self) -> SensorModel {
+        estimate_sensor(&self.carry, self.traj).unwrap_or(SensorModel {
+            name: "spinning lidar",
+            rings: 64,
+            rate_hz: 10.0,
+            azimuth_step_deg: 0.35,
+        })
+    }
+
+    /// Cuts the carried points into runs, runs the closed ones through the core and
+    /// returns the points before the earliest open run.
+    fn run(&mut self, last: bool) -> Result<Option<CoreBatch>, CoreError> {
+        let sensor = self.sensor.unwrap_or(SensorModel::VLP16);
+        let period = 1.0 / f64::from(sensor.rate_hz.max(0.1));
+        let gap = 0.25 * period;
+        let c = &self.carry;
+        let n = c.len();
+        let mut body = std::mem::take(&mut self.body);
+        if body.len() < n {
+            let mut cur = PoseCursor::new(self.traj);
+            body.extend((body.len()..n).map(|i| {
+                body_of(&mut cur, c.x[i], c.y[i], c.z[i], c.t[i]).unwrap_or(Body {
+                    x: f32::NAN,
+                    y: f32::NAN,
+                    z: f32::NAN,
+                })
+            }));
+        }
+        let mut open: Vec<Option<Run>> = (0..256).map(|_| None).collect();
+        let mut closed: Vec<Run> = Vec::new();
+        let (min2, lat) = (self.arc.min_range_m.powi(2), self.arc.max_lateral_m);
+        // 1: too near, 2: too far to the side; counted once the point leaves the carry.
+        let mut left_out = vec![0u8; n];
+        for (i, &p) in body.iter().enumerate() {
+            if p.x.is_nan() {
+                continue;
+            }
+            if p.x * p.x + p.y * p.y < min2 {
+                left_out[i] = 1;
+                continue;
+            }
+            if p.y.abs() > lat {
+                left_out[i] = 2;
+                continue;
+            }
+            let ring = c.channel[i];
+            let front = p.x >= 0.0;
+            let slot = &mut open[usize::from(ring)];
+            match slot {
+                Some(r) if r.front == front && c.t[i] - r.last_t <= gap => {
+                    r.points.push(i as u32);
+                    r.last_t = c.t[i];
+                }
+                _ => {
+                    if let Some(r) = slot.take() {
+                        closed.push(r);
+                    }
+                    *slot = Some(Run {
+                        front,
+                        points: vec![i as u32],
+                        last_t: c.t[i],
+                    });
+                }
+            }
+        }
+        let t_end = c.t.last().copied().unwrap_or(f64::NEG_INFINITY);
+        let mut held: Vec<Run> = Vec::new();
+        for r in open.into_iter().flatten() {
+            if last || t_end - r.last_t > gap {
+                closed.push(r);
+            } else {
+                held.push(r);
+            }
+        }
+        // The cut: before every open run, and before every closed run that reaches it.
+        let mut cut = held.iter().map(|r| r.points[0] as usize).min().unwrap_or(n);
+        loop {
+            let c2 = closed
+                .iter()
+                .filter(|r| *r.points.last().unwrap_or(&0) as usize >= cut)
+                .map(|r| r.points[0] as usize)
+                .min()
+                .unwrap_or(cut)
+                .min(cut);
+            if c2 == cut {
+                break;
+            }
+            cut = c2;
+        }
+        if cut == 0 {
+            self.body = body;
+            return Ok(None);
+        }
+        closed.retain(|r| (*r.points.last().unwrap_or(&0) as usize) < cut);
+        closed.sort_by_key(|r| r.points[0]);
+        self.arcs.points_near += left_out[..cut].iter().filter(|&&f| f == 1).count() as u64;
+        self.arcs.points_lateral += left_out[..cut].iter().filter(|&&f| f == 2).count() as u64;
+        let mut arcs: Vec<Vec<u32>> = Vec::with_capacity(closed.len());
+        for r in closed {
+            if let Some(a) = self.accept(&body, r) {
+                arcs.push(a);
+            }
+        }
+        let kernel = self.kernel.unwrap_or_else(|| sensor.kernel_params());
+        let out = self.run_core(&body, &arcs, &sensor, &kernel, cut)?;
+        body.drain(..cut);
+        self.body = body;
+        Ok(Some(out))
+    }
+
+    /// Thinning and the road checks of one run (`rings::arc`'s rule).
+    fn accept(&mut self, body: &[Body], r: Run) -> Option<Vec<u32>> {
+        let p = &self.arc;
+        let c = &mut self.arcs;
+        if r.points.len() < p.min_points {
+            c.skipped_short += 1;
+            return None;
+        }
+        let sep2 = p.min_separation_m * p.min_separation_m;
+        let mut pts = Vec::with_capacity(r.points.len());
+        let mut lastp = (f32::INFINITY, f32::INFINITY);
+        for &i in &r.points {
+            let b = body[i as usize];
+            let (xp, zp) = project(b.x, b.y, b.z);
+            let (dx, dz) = (xp - lastp.0, zp - lastp.1);
+            if dx * dx + dz * dz < sep2 {
+                c.points_piled += 1;
+                continue;
+            }
+            lastp = (xp, zp);
+            pts.push(i);
+        }
+        let nadir = pts.iter().copied().min_by(|&a, &b| {
+            body[a as usize]
+                .y
+                .abs()
+                .total_cmp(&body[b as usize].y.abs())
+        })?;
+        let mut centre: Vec<f32> = pts
+            .iter()
+            .map(|&i| body[i as usize])
+            .filter(|b| b.y.abs() <= 1.0)
+            .map(|b| b.z)
+            .collect();
+        if centre.is_empty() {
+            c.skipped_no_road += 1;
+            return None;
+        }
+        let mid = centre.len() / 2;
+        let z_mid = *centre.select_nth_unstable_by(mid, f32::total_cmp).1;
+        if z_mid > -p.min_depth_m {
+            c.skipped_no_road += 1;
+            return None;
+        }
+        if body[nadir as usize].x.abs() > p.max_reach_m {
+            c.skipped_far += 1;
+            return None;
+        }
+        c.arcs += 1;
+        c.points_in_arcs += pts.len() as u64;
+        Some(pts)
+    }
+
+    /// Runs `arcs` through a fresh pipeline (config packet first, one line per arc) and
+    /// returns the first `cut` carried points with the core's output.
+    fn run_core(
+        &mut self,
+        body: &[Body],
+        arcs: &[Vec<u32>],
+        sensor: &SensorModel,
+        kernel: &KernelParams,
+        cut: usize,
+    ) -> Result<CoreBatch, CoreError> {
+        let mut rho = vec![0.0f32; cut];
+        let mut status: Vec<Option<PointStatus>> = vec![None; cut];
+        let mut scanline = vec![0u32; cut];
+        let mut cands: Vec<Candidate> = Vec::new();
+        let base_line = self.lines;
+        let mut counters = ReplayCounters::default();
+        {
+            let mut line_no = 0u32;
+            let mut collect = |o: &ScanlineOutput<'_>| {
+                let line = base_line + line_no;
+                line_no += 1;
+                counters.scanlines += 1;
+                counters.truncated += u64::from(o.truncated);
+                for (k, &tag) in o.tag.iter().enumerate() {
+                    let j = tag as usize;
+                    if j >= cut {
+                        continue;
+                    }
+                    rho[j] = o.rho_deg[k];
+                    status[j] = Some(o.status[k]);
+                    scanline[j] = line;
+                    match o.status[k] {
+                        PointStatus::Kept => counters.kept += 1,
+                        PointStatus::Irregular => counters.irregular += 1,
+                        PointStatus::NoNeighbour => counters.no_neighbour += 1,
+                        _ => {}
+                    }
+                }
+                for (side, k) in [(Side::Left, o.left), (Side::Right, o.right)] {
+                    if let Some(&tag) = k.and_then(|k| o.tag.get(usize::from(k))) {
+                        cands.push(Candidate {
+                            point: tag,
+                            side,
+                            scanline: line,
+                        });
+                    }
+                }
+            };
+            *self.pipe = ArcPipeline::new();
+            let pipe = &mut *self.pipe;
+            let mut enc = StreamEncoder::new();
+            let mut buf = vec![0u8; MAX_PACKET_LEN];
+            let enc_err = |e| CoreError::Replay(ReplayError::Encode(e));
+            let m = enc
+                .encode_config(&kernel.to_words(), &mut buf)
+                .map_err(enc_err)?;
+            feed(pipe, &buf[..m], &mut collect)?;
+            counters.packets += 1;
+            counters.bytes += m as u64;
+            let period_ns = (1e9 / sensor.rate_hz.max(0.1)) as u64;
+            let step_ns =
+                ((sensor.azimuth_step_deg / 360.0) * 1e9 / sensor.rate_hz.max(0.1)).max(1.0) as u32;
+            let mut recs: Vec<PointRecord> = Vec::with_capacity(MAX_POINTS_PER_PACKET);
+            for (a, arc) in arcs.iter().enumerate() {
+                let t_arc = (u64::from(base_line) + a as u64 + 1) * period_ns;
+                for (ci, chunk) in arc.chunks(MAX_POINTS_PER_PACKET).enumerate() {
+                    recs.clear();
+                    let k0 = ci * MAX_POINTS_PER_PACKET;
+                    for (j, &i) in chunk.iter().enumerate() {
+                        let b = body[i as usize];
+                        let (xp, zp) = project(b.x, b.y, b.z);
+                        recs.push(PointRecord {
+                            dt_ns: j as u32 * step_ns,
+                            x_m: xp,
+                            z_m: zp,
+                            intensity: self.carry.intensity[i as usize],
+                            line_start: k0 + j == 0,
+                            tag: i,
+                        });
+                    }
+                    let t0 = t_arc + k0 as u64 * u64::from(step_ns);
+                    let m = enc.encode_points(t0, &recs, &mut buf).map_err(enc_err)?;
+                    feed(pipe, &buf[..m], &mut collect)?;
+                    counters.packets += 1;
+                    counters.bytes += m as u64;
+                    counters.points_sent += chunk.len() as u64;
+                }
+                pipe.run(&mut collect);
+            }
+            pipe.finish(&mut collect);
+            self.lines = self.lines.saturating_add(line_no);
+        }
+        let rest = {
+            let mut r =
+                PointBatch::with_capacity(self.carry.len() - cut + super::STREAM_BATCH_POINTS);
+            r.extend_from(&self.carry, cut..self.carry.len());
+            r
+        };
+        let mut cols = std::mem::replace(&mut self.carry, rest);
+        cols.keep_range(0..cut);
+        let base = self.next_base;
+        self.next_base += cut as u64;
+        self.points += cut as u64;
+        self.counters.add(&counters);
+        Ok(CoreBatch {
+            base,
+            x: cols.x,
+            y: cols.y,
+            z: cols.z,
+            t: cols.t,
+            rho_deg: rho,
+            status,
+            scanline,
+            candidates: cands,
+        })
+    }
+}
+
+/// Writes `b` into the pipeline, processing complete lines whenever the ring is full.
+fn feed(
+    pipe: &mut ArcPipeline,
+    b: &[u8],
+    on_line: &mut impl FnMut(&ScanlineOutput<'_>),
+) -> Result<(), CoreError> {
+    let mut off = 0;
+    while off < b.len() {
+        let w = pipe.write(&b[off..]);
+        off += w;
+        if w == 0 {
+            pipe.run(&mut *on_line);
+            let w2 = pipe.write(&b[off..]);
+            if w2 == 0 {
+                return Err(CoreError::Replay(ReplayError::Stalled));
+            }
+            off += w2;
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::{BTreeMap, BTreeSet};
+    use std::path::Path;
+
+    /// A sensor 1.8 m above a road, standing at the origin facing north (heading 0°: left
+    /// is west, −x), 10 Hz, 0.2° between firings, 8 lasers meeting the road 5–15 m out.
+    /// A 0.15 m kerb on the left 3 m out (x < −3 is higher), none on the right.
+    const H: f64 = 1.8;
+    const RINGS: usize = 8;
+
+    fn traj() -> Trajectory {
+        let csv = "time,x,y,z,roll,pitch,heading\n100,0,0,1.8,0,0,0\n101,0,0,1.8,0,0,0\n";
+        Trajectory::parse_csv(Path::new("t.csv"), csv).expect("trajectory parses")
+    }
+
+    /// `revs` revolutions from t = 100.05 s, firings in time order, clockwise from behind.
+    fn stream(revs: usize) -> PointBatch {
+        let firings = 1800;
+        let mut b = PointBatch::default();
+        for f in 0..revs * firings {
+            let t = 100.05 + f as f64 / (10.0 * firings as f64);
+            let phi = (180.0 - 0.2 * f as f64).to_radians();
+            for k in 0..RINGS {
+                let r = 5.0 + 10.0 * k as f64 / (RINGS - 1) as f64;
+                let (yb, xb) = (r * phi.sin(), r * phi.cos());
+                // Body (forward, left) to world for heading 0: x = −left, y = forward.
+                let (x, y) = (-yb, xb);
+                let z = if x < -3.0 { 0.15 } else { 0.0 };
+                let _ = H;
+                b.push(x, y, z, t + k as f64 * 1e-6, 100, 0.0, k as u8);
+            }
+        }
+        b
+    }
+
+    fn run_all(b: &PointBatch, batch: usize) -> (Vec<CoreBatch>, RingStage<'static>) {
+        let tr: &'static Trajectory = Box::leak(Box::new(traj()));
+        let mut st = RingStage::new(tr, ArcParams::default(), None);
+        let mut out = Vec::new();
+        let mut i = 0;
+        while i < b.len() {
+            let j = (i + batch).min(b.len());
+            let mut part = PointBatch::default();
+            part.extend_from(b, i..j);
+            out.extend(st.push(part).expect("stage runs"));
+            i = j;
+        }
+        out.extend(st.finish().expect("stage finishes"));
+        (out, st)
+    }
+
+    #[test]
+    fn every_scanline_is_one_ring_in_one_half_and_the_batches_do_not_matter() {
+        let b = stream(3);
+        let (out, st) = run_all(&b, 32_768);
+        let n: usize = out.iter().map(|c| c.t.len()).sum();
+        assert_eq!(n, b.len(), "every point comes out once");
+        // Scanline → (ring, front) of its points.
+        let mut lines: BTreeMap<u32, BTreeSet<(u8, bool)>> = BTreeMap::new();
+        for c in &out {
+            for (k, s) in c.status.iter().enumerate() {
+                if s.is_some() {
+                    let g = (c.base as usize) + k;
+                    lines
+                        .entry(c.scanline[k])
+                        .or_default()
+                        .insert((b.channel[g], b.y[g] >= 0.0));
+                }
+            }
+        }
+        assert!(lines.values().all(|v| v.len() == 1), "{lines:?}");
+        // Three revolutions: the first and last half revolution of each ring are cut
+        // short by the stream's ends; at least 5 whole halves per ring.
+        assert!(lines.len() >= RINGS * 5, "{} scanlines", lines.len());
+        assert_eq!(st.counters.scanlines as usize, lines.len());
+        // The sensor is estimated from the data: 0.2° at 10 Hz.
+        let s = st.sensor().expect("estimated");
+        assert!((s.azimuth_step_deg - 0.2).abs() < 0.01, "{s:?}");
+        assert!((s.rate_hz - 10.0).abs() < 0.2, "{s:?}");
+        assert_eq!(s.rings as usize, RINGS);
+        // Cut into other batch sizes, the output is the same.
+        let cands = |o: &[CoreBatch]| -> Vec<(u64, Side)> {
+            o.iter()
+                .flat_map(|c| {
+                    c.candidates
+                        .iter()
+                        .map(|k| (c.base + u64::from(k.point), k.side))
+                })
+                .collect()
+        };
+        let (other, _) = run_all(&b, 5_000);
+        assert_eq!(cands(&out), cands(&other));
+    }
+
+    #[test]
+    fn the_left_kerb_gives_left_candidates_ahead_and_behind() {
+        let b = stream(2);
+        let (out, _) = run_all(&b, 32_768);
+        let (mut left, mut right) = (0, 0);
+        let (mut ahead, mut behind) = (0, 0);
+        for c in &out {
+            for k in &c.candidates {
+                let g = c.base as usize + k.point as usize;
+                match k.side {
+                    Side::Left => {
+                        left += 1;
+                        // The toe: the last road point before x = −3 (west is left).
+                        assert!(
+                            (b.x[g] + 3.0).abs() < 0.1,
+                            "left candidate at x = {}",
+                            b.x[g]
+                        );
+                        if b.y[g] > 0.0 {
+                            ahead += 1;
+                        } else {
+                            behind += 1;
+                        }
+                    }
+                    Side::Right => right += 1,
+                }
+            }
+        }
+        assert!(
+            ahead >= RINGS && behind >= RINGS,
+            "{ahead} ahead, {behind} behind"
+        );
+        assert!(
+            left >= 2 * RINGS && right == 0,
+            "{left} left, {right} right"
+        );
+    }
+
+    #[test]
+    fn a_spinning_stream_looks_spinning_and_a_profile_does_not() {
+        let tr = traj();
+        assert!(looks_spinning(&stream(1), &tr));
+        // A profiler: one plane across the road, 2 000 pulses per line, 100 lines/s.
+        let mut p = PointBatch::default();
+        for line in 0..10 {
+            for j in 0..2000 {
+                let t = 100.05 + line as f64 / 100.0 + j as f64 / 200_000.0;
+                let a = (-180.0 + 360.0 * (j as f64 + 0.5) / 2000.0_f64).to_radians();
+                let (x, z) = (10.0 * a.sin(), H - 10.0 * a.cos());
+                p.push(x, 0.0, z, t, 100, 0.0, 0);
+            }
+        }
+        assert!(!looks_spinning(&p, &tr));
+    }
+}
