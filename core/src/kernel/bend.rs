@@ -496,17 +496,26 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
     let mut capped = forward_sweep(x, z, d2, s_off);
     let mut t = n.saturating_sub(1);
     // The nadir (`seed::nadir`: smallest |x′| with z′ < 0, the first on a tie): walking
-    // backwards, a tie replaces, so the lowest index wins. The points are finite here
-    // (the kernel set the others aside), so +∞ stands for "none yet".
-    let (mut best, mut nadir) = (f32::INFINITY, usize::MAX);
+    // backwards, a tie replaces, so the lowest index wins. Compared as bit patterns: for
+    // |x′| (sign cleared) they order as the floats do, and z′ < 0 is a pattern above
+    // −0's. The points are finite here (the kernel set the others aside), so no |x′| has
+    // the key u32::MAX that stands for "not below the scanner" and for "none yet"; a point
+    // not below the scanner may take `nadir` while `best` is still u32::MAX, and the first
+    // point below it takes it back.
+    let (mut best, mut nadir) = (u32::MAX, usize::MAX);
     let mut lone = 0u32;
     for j in (0..n).rev() {
         let (bx, bz) = back_walk(x, z, d2, j, &mut t, &mut capped);
         t_off[j] = (t - j) as u8;
         if LEAN {
-            let ax = math::abs(x[j]);
-            if z[j] < 0.0 && ax <= best {
-                (best, nadir) = (ax, j);
+            let below = z[j].to_bits() > 0x8000_0000;
+            let key = if below {
+                x[j].to_bits() & 0x7FFF_FFFF
+            } else {
+                u32::MAX
+            };
+            if key <= best {
+                (best, nadir) = (key, j);
             }
         }
         let s = j - usize::from(s_off[j]);
@@ -519,7 +528,7 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
     }
     (
         capped,
-        LEAN.then_some((nadir != usize::MAX).then_some(nadir)),
+        LEAN.then_some((best != u32::MAX).then_some(nadir)),
         lone,
     )
 }
