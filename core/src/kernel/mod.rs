@@ -319,8 +319,15 @@ impl<const N: usize> Kernel<N> {
 
         // 1. §2.3–2.4 on the raw line.
         let s_off = &mut self.s_off[..n];
+        // Inside a region that lies within ±MAX_COORD_M every point is in range.
+        let in_range = p.roi().is_some_and(|r| {
+            let m = bend::MAX_COORD_M;
+            [r.x_min, r.x_max, r.z_min, r.z_max]
+                .iter()
+                .all(|v| (-m..=m).contains(v))
+        });
         let (capped, irr, non_finite) =
-            bend::windows_marked(x, z, d2, s_off, aux, irregular, status);
+            bend::windows_marked(x, z, d2, s_off, aux, irregular, status, in_range);
         c.capped_windows += capped;
         c.irregular = irr;
         c.non_finite = non_finite;
