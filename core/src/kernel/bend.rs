@@ -499,8 +499,12 @@ fn windows_sweeps_marked<const IN_RANGE: bool>(
 /// are still in registers; elsewhere it is the two calls. The same values either way
 /// (tested). With `LEAN`, a ρ that [`LowCut::below`] puts below τ_min is not computed:
 /// the point gets τ_min itself (see [`LowCut`]); and on the M4F the sweep also finds the
-/// nadir (`seed::nadir`), returned as `Some(nadir)` (`None`: not searched). The last
-/// value is the number of points without a neighbour on a side (ρ = 0).
+/// nadir (`seed::nadir`), returned as `Some(nadir)` (`None`: not searched), and lists
+/// the points whose ρ it computed (every point with ρ above τ_min among them) in
+/// `exact`, highest index first: their number, `None` when not listed or when `exact`
+/// was too short. The third value is the number of points without a neighbour on a side
+/// (ρ = 0).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn windows_angles<M: Maths, const LEAN: bool>(
     x: &[f32],
     z: &[f32],
@@ -509,13 +513,14 @@ pub(crate) fn windows_angles<M: Maths, const LEAN: bool>(
     t_off: &mut [u8],
     rho: &mut [f32],
     cut: LowCut,
-) -> (u32, Option<Option<usize>>, u32) {
+    exact: &mut [u16],
+) -> (u32, Option<Option<usize>>, u32, Option<usize>) {
     if cfg!(target_pointer_width = "64") {
         let capped = windows(x, z, d2, s_off, t_off);
         let lone = bend_angles::<M, LEAN>(x, z, s_off, t_off, rho, cut);
-        (capped, None, lone)
+        (capped, None, lone, None)
     } else {
-        windows_sweeps_angles::<M, LEAN>(x, z, d2, s_off, t_off, rho, cut)
+        windows_sweeps_angles::<M, LEAN>(x, z, d2, s_off, t_off, rho, cut, exact)
     }
 }
 
@@ -523,6 +528,7 @@ pub(crate) fn windows_angles<M: Maths, const LEAN: bool>(
 #[inline(never)] // its own registers (see `mark_irregular`)
 #[cfg_attr(all(not(test), target_pointer_width = "64"), allow(dead_code))]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN counts as beyond, as in `beyond`
+#[allow(clippy::too_many_arguments)]
 fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
     x: &[f32],
     z: &[f32],
@@ -531,7 +537,8 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
     t_off: &mut [u8],
     rho: &mut [f32],
     cut: LowCut,
-) -> (u32, Option<Option<usize>>, u32) {
+    exact: &mut [u16],
+) -> (u32, Option<Option<usize>>, u32, Option<usize>) {
     let n = x.len();
     let (z, s_off, t_off, rho) = (&z[..n], &mut s_off[..n], &mut t_off[..n], &mut rho[..n]);
     let mut capped = forward_sweep(x, z, d2, s_off);
@@ -545,6 +552,7 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
     // point below it takes it back.
     let (mut best, mut nadir) = (u32::MAX, usize::MAX);
     let mut lone = 0u32;
+    let mut listed = 0usize;
     for j in (0..n).rev() {
         let (bx, bz) = back_walk(x, z, d2, j, &mut t, &mut capped);
         t_off[j] = (t - j) as u8;
@@ -563,14 +571,26 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
         rho[j] = if s == j || t == j {
             lone += 1;
             0.0
+        } else if LEAN {
+            match lean_rho::<M>(x, z, s, j, t, (bx, bz), cut) {
+                Some(r) => {
+                    if let Some(e) = exact.get_mut(listed) {
+                        *e = j as u16;
+                    }
+                    listed += 1;
+                    r
+                }
+                None => cut.floor,
+            }
         } else {
-            lean_or_exact::<M, LEAN>(x, z, s, j, t, (bx, bz), cut)
+            bend_angle_deg_b::<M>(x, z, s, j, t, (bx, bz))
         };
     }
     (
         capped,
         LEAN.then_some((best != u32::MAX).then_some(nadir)),
         lone,
+        (LEAN && listed <= exact.len()).then_some(listed),
     )
 }
 
@@ -669,20 +689,35 @@ fn lean_or_exact<M: Maths, const LEAN: bool>(
     cut: LowCut,
 ) -> f32 {
     if LEAN {
-        let (ax, az) = (x[i] - x[s], z[i] - z[s]);
-        let (bx, bz) = b;
-        let (c, d) = (ax * bz - az * bx, ax * bx + az * bz);
-        if cut.below(math::abs(c), d) {
-            return cut.floor;
-        }
-        let (cs, d) = bend_cs_d(x, z, s, i, t, b);
-        if cut.below(cs, d) {
-            return cut.floor;
-        }
-        rho_deg::<M>(cs, d)
+        lean_rho::<M>(x, z, s, i, t, b, cut).unwrap_or(cut.floor)
     } else {
         bend_angle_deg_b::<M>(x, z, s, i, t, b)
     }
+}
+
+/// The lean half of [`lean_or_exact`]: ρ, or `None` where `cut` puts it certainly below
+/// τ_min.
+#[inline(always)]
+fn lean_rho<M: Maths>(
+    x: &[f32],
+    z: &[f32],
+    s: usize,
+    i: usize,
+    t: usize,
+    b: (f32, f32),
+    cut: LowCut,
+) -> Option<f32> {
+    let (ax, az) = (x[i] - x[s], z[i] - z[s]);
+    let (bx, bz) = b;
+    let (c, d) = (ax * bz - az * bx, ax * bx + az * bz);
+    if cut.below(math::abs(c), d) {
+        return None;
+    }
+    let (cs, d) = bend_cs_d(x, z, s, i, t, b);
+    if cut.below(cs, d) {
+        return None;
+    }
+    Some(rho_deg::<M>(cs, d))
 }
 
 /// The arguments of the bend angle's arctangent at `i` with neighbours `s` and `t` and
@@ -918,7 +953,7 @@ mod tests {
                     LowCut::NONE,
                 );
                 let (mut s4, mut t4, mut rho4) = ([0u8; N], [0u8; N], [0f32; N]);
-                let (c4, _, lone4) = windows_sweeps_angles::<Selected, false>(
+                let (c4, _, lone4, _) = windows_sweeps_angles::<Selected, false>(
                     &x[..n],
                     &z[..n],
                     d2,
@@ -926,6 +961,7 @@ mod tests {
                     &mut t4,
                     &mut rho4[..n],
                     LowCut::NONE,
+                    &mut [],
                 );
                 assert_eq!(c4, c1, "case {case} d2 {d2}");
                 assert_eq!(lone4, lone1, "case {case} d2 {d2}");
@@ -943,7 +979,8 @@ mod tests {
                 let mut rho5 = [0f32; N];
                 bend_angles::<Selected, true>(&x[..n], &z[..n], &s1, &t1, &mut rho5[..n], cut);
                 let (mut s6, mut t6, mut rho6) = ([0u8; N], [0u8; N], [0f32; N]);
-                let (_, nd, _) = windows_sweeps_angles::<Selected, true>(
+                let mut exact = [0u16; N];
+                let (_, nd, _, listed) = windows_sweeps_angles::<Selected, true>(
                     &x[..n],
                     &z[..n],
                     d2,
@@ -951,7 +988,32 @@ mod tests {
                     &mut t6,
                     &mut rho6[..n],
                     cut,
+                    &mut exact,
                 );
+                // The list holds every point with ρ above τ_min, highest index first.
+                let listed = &exact[..listed.expect("a list as long as the line")];
+                assert!(listed.windows(2).all(|w| w[0] > w[1]), "case {case}");
+                for i in 0..n {
+                    if rho6[i] > cut.floor {
+                        assert!(listed.contains(&(i as u16)), "case {case} i {i}");
+                    }
+                }
+                // A list too short says so.
+                if listed.len() > 1 {
+                    let mut short = [0u16; 1];
+                    let (mut s7, mut t7, mut rho7) = ([0u8; N], [0u8; N], [0f32; N]);
+                    let r = windows_sweeps_angles::<Selected, true>(
+                        &x[..n],
+                        &z[..n],
+                        d2,
+                        &mut s7,
+                        &mut t7,
+                        &mut rho7[..n],
+                        cut,
+                        &mut short,
+                    );
+                    assert_eq!(r.3, None, "case {case}");
+                }
                 if case % 3 != 1 && !(case % 4 != 0 && case % 5 == 2) {
                     // Finite points in range only: the sweep's nadir is `seed::nadir`'s.
                     assert_eq!(nd, Some(super::super::seed::nadir(&x[..n], &z[..n])));

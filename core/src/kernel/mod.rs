@@ -155,6 +155,10 @@ pub struct ScanlineOutput<'a> {
     pub output_mode: OutputMode,
 }
 
+/// Length of [`Kernel`]'s list of points with an exact ρ in a lean pass; a line with more
+/// of them has its peaks found by a scan of ρ instead (the same result).
+const EXACT_LEN: usize = 256;
+
 /// Values derived from the parameters once, not per line.
 #[derive(Clone, Copy, Debug)]
 struct Derived {
@@ -202,6 +206,9 @@ pub struct Kernel<const N: usize> {
 
     /// The peak search's window-maximum deque.
     deque: [u16; seed::DEQUE_LEN],
+    /// The points whose ρ a lean pass computed (`bend::windows_angles`), for the peak
+    /// search to visit instead of scanning ρ.
+    exact: [u16; EXACT_LEN],
     /// `params_hash` and `derived` are still to be computed from `params` (a kernel made
     /// by the `const` [`Kernel::new`] computes them on its first line).
     fresh: bool,
@@ -228,6 +235,7 @@ impl<const N: usize> Kernel<N> {
             aux: [0; N],
             s_off: [0; N],
             deque: [0; seed::DEQUE_LEN],
+            exact: [0; EXACT_LEN],
             fresh: true,
             lean_rho: false,
         }
@@ -362,10 +370,12 @@ impl<const N: usize> Kernel<N> {
         // 4. ρ on the smoothed line.
         let s_off = &mut s_off[..kept];
         let (t_off, rk) = (&mut aux[..kept], &mut rho[..kept]);
-        let (capped, swept_nadir, lone) = if lean {
-            bend::windows_angles::<M, true>(xk, zk, d2, s_off, t_off, rk, low_cut)
+        let ex = &mut self.exact;
+        let (capped, swept_nadir, lone, listed) = if lean {
+            bend::windows_angles::<M, true>(xk, zk, d2, s_off, t_off, rk, low_cut, ex)
         } else {
-            bend::windows_angles::<M, false>(xk, zk, d2, s_off, t_off, rk, bend::LowCut::NONE)
+            let none = bend::LowCut::NONE;
+            bend::windows_angles::<M, false>(xk, zk, d2, s_off, t_off, rk, none, ex)
         };
         c.capped_windows += capped;
         if !lean {
@@ -393,6 +403,7 @@ impl<const N: usize> Kernel<N> {
             tau_min: p.tau_min_deg,
             tau_max: p.tau_max_deg,
             nadir,
+            exact: listed.map(|k| &self.exact[..k]),
         };
         let seeds = if lean {
             // Statuses of the candidates are Kept (peaks have both neighbours).
