@@ -382,6 +382,38 @@ fn smooth_piece(v: &mut [f32], scratch: &mut [f32], steps: u32, b: &Block) {
     }
 }
 
+/// The end of the piece that starts at `start` (< `x.len()`): the first point more than
+/// the gap (`gap2`, squared) from its predecessor, or the line's length.
+#[inline(always)]
+fn piece_end(x: &[f32], z: &[f32], start: usize, gap2: f32) -> usize {
+    let n = x.len();
+    let z = &z[..n];
+    let apart = |(ax, az): (f32, f32), (bx, bz): (f32, f32)| {
+        let (dx, dz) = (bx - ax, bz - az);
+        dx * dx + dz * dz > gap2
+    };
+    // Two points per round, so that the previous point stays in its registers (two
+    // loads per point, no moves).
+    let mut p = (x[start], z[start]);
+    let mut e = start + 1;
+    while e + 1 < n {
+        let c = (x[e], z[e]);
+        if apart(p, c) {
+            return e;
+        }
+        let q = (x[e + 1], z[e + 1]);
+        if apart(c, q) {
+            return e + 1;
+        }
+        p = q;
+        e += 2;
+    }
+    if e < n && apart(p, (x[e], z[e])) {
+        return e;
+    }
+    n
+}
+
 /// Taubin-smooths the line `x`, `z` in place, piece by piece (split where consecutive
 /// points are more than `gap_m` apart; `gap_m` ≤ 0 never splits). `scratch` must be at
 /// least as long as the line (the per-step form ping-pongs through it). Returns the number
@@ -406,19 +438,7 @@ pub(crate) fn taubin_smooth(
     let mut start = 0;
     while start < n {
         let end = if split {
-            // The previous point stays in registers: two loads per point.
-            let (mut px, mut pz) = (x[start], z[start]);
-            let mut e = start + 1;
-            while e < n {
-                let (cx, cz) = (x[e], z[e]);
-                let (dx, dz) = (cx - px, cz - pz);
-                if dx * dx + dz * dz > gap2 {
-                    break;
-                }
-                (px, pz) = (cx, cz);
-                e += 1;
-            }
-            e
+            piece_end(x, z, start, gap2)
         } else {
             n
         };
