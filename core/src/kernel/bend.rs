@@ -103,11 +103,6 @@ fn forward_sweep(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8]) -> u32 {
             let (dx, dz) = (x[j] - xi, z[j] - zi);
             !(dx * dx + dz * dz <= d2)
         };
-        // s ≤ i: max(s, i − MAX_SIDE) without the saturating subtraction; rare (runs of
-        // returns on one spot), so out of the way of the common path.
-        if i - s > MAX_SIDE {
-            s = side_cap(i);
-        }
         while s < i && far(s) {
             s += 1;
         }
@@ -115,16 +110,13 @@ fn forward_sweep(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8]) -> u32 {
         s_off[i] = off as u8;
         if off == MAX_SIDE {
             capped += fwd_capped(x, z, d2, s, i);
+            // The next point's window starts at max(s, i + 1 − MAX_SIDE) = s + 1: the cap
+            // taken here, where the window is known to be full, rather than tested for
+            // at every point.
+            s += 1;
         }
     }
     capped
-}
-
-/// i − [`MAX_SIDE`]: the forward window's cap, out of line (see [`forward_sweep`]).
-#[cold]
-#[inline(never)]
-fn side_cap(i: usize) -> usize {
-    i - MAX_SIDE
 }
 
 /// Whether the forward window of `i`, stopped at s = i − [`MAX_SIDE`], is capped: 1 if
