@@ -985,8 +985,8 @@ mod tests {
                 // The list holds every point with ρ above τ_min, highest index first.
                 let listed = &exact[..listed.expect("a list as long as the line")];
                 assert!(listed.windows(2).all(|w| w[0] > w[1]), "case {case}");
-                for i in 0..n {
-                    if rho6[i] > cut.floor {
+                for (i, r) in rho6[..n].iter().enumerate() {
+                    if *r > cut.floor {
                         assert!(listed.contains(&(i as u16)), "case {case} i {i}");
                     }
                 }
