@@ -33,14 +33,15 @@
 //! ([`bend::LowCut`]), the region's points compacted rather than partitioned, the kept
 //! points' partition not undone (only the three indices mapped back), no per-point
 //! statuses, the nadir and the points without a neighbour found inside the smoothed pass's
-//! sweep, and the peak pass looking only at points whose ρ is above τ_min. The packet is the same byte
-//! for byte (tested, and compared on whole streams by `firmware/check.sh`).
+//! sweep, and the peak pass looking only at points whose ρ is above τ_min (on the M4F those
+//! the sweep lists as computed). The packet is the same byte for byte (tested, and compared on whole streams by `firmware/check.sh`).
 //!
 //! # Memory
 //!
 //! Per point of capacity `N`: the line's x′, z′, tag (12 bytes) plus the kernel's ρ (`f32`),
 //! status (`u8`) and two `u8` of working space (the window's ends as offsets; the right one
-//! later holds the status of a kept point) — 19 bytes — plus a 1 KiB deque for the peak search and the parameters.
+//! later holds the status of a kept point) — 19 bytes — plus a 1 KiB deque for the peak search,
+//! the lean pass's list of points with an exact ρ (512 bytes) and the parameters.
 //! ρ's buffer doubles as the smoothing scratch before ρ is computed.
 
 use crate::math::{self, Maths};
