@@ -103,11 +103,6 @@ fn forward_sweep(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8]) -> u32 {
             let (dx, dz) = (x[j] - xi, z[j] - zi);
             !(dx * dx + dz * dz <= d2)
         };
-        // s ≤ i: max(s, i − MAX_SIDE) without the saturating subtraction; rare (runs of
-        // returns on one spot), so out of the way of the common path.
-        if i - s > MAX_SIDE {
-            s = side_cap(i);
-        }
         while s < i && far(s) {
             s += 1;
         }
@@ -115,16 +110,13 @@ fn forward_sweep(x: &[f32], z: &[f32], d2: f32, s_off: &mut [u8]) -> u32 {
         s_off[i] = off as u8;
         if off == MAX_SIDE {
             capped += fwd_capped(x, z, d2, s, i);
+            // The next point's window starts at max(s, i + 1 − MAX_SIDE) = s + 1: the cap
+            // taken here, where the window is known to be full, rather than tested for
+            // at every point.
+            s += 1;
         }
     }
     capped
-}
-
-/// i − [`MAX_SIDE`]: the forward window's cap, out of line (see [`forward_sweep`]).
-#[cold]
-#[inline(never)]
-fn side_cap(i: usize) -> usize {
-    i - MAX_SIDE
 }
 
 /// Whether the forward window of `i`, stopped at s = i − [`MAX_SIDE`], is capped: 1 if
@@ -166,6 +158,38 @@ fn back_walk(
         }
         *t -= 1;
     }
+    (0.0, 0.0)
+}
+
+/// [`back_walk`] over the candidates j + 1 ..= t as slices, walked from t down: one
+/// bounds check per point rather than one per step. The same result; fewer instructions
+/// in the raw line's sweep, more in the smoothed one's (registers), so each takes its own.
+#[inline(always)]
+fn back_walk_sliced(
+    x: &[f32],
+    z: &[f32],
+    d2: f32,
+    j: usize,
+    t: &mut usize,
+    capped: &mut u32,
+) -> (f32, f32) {
+    let (xj, zj) = (x[j], z[j]);
+    if *t - j > MAX_SIDE {
+        let (cap, stopped) = back_cap(x, z, d2, j);
+        *t = cap;
+        *capped += stopped;
+    }
+    let hi = *t;
+    let (xs, zs) = (&x[j + 1..=hi], &z[j + 1..=hi]);
+    let zs = &zs[..xs.len()];
+    for k in (0..xs.len()).rev() {
+        let (dx, dz) = (xs[k] - xj, zs[k] - zj);
+        if dx * dx + dz * dz <= d2 {
+            *t = j + 1 + k;
+            return (dx, dz);
+        }
+    }
+    *t = j;
     (0.0, 0.0)
 }
 
@@ -333,9 +357,10 @@ fn judge(x: &[f32], z: &[f32], i: usize, so: usize, to: usize, thr: Threshold) -
     judge_with(x, z, i, i - so, i + to, thr)
 }
 
-/// [`judge`] with b = p_t − p_i already computed (by the backward sweep).
+/// [`judge`] with b = p_t − p_i already computed (by the backward sweep); with `IN_RANGE`
+/// the point is known to be finite and within ±[`MAX_COORD_M`].
 #[inline(always)]
-fn judge_b(
+fn judge_b<const IN_RANGE: bool>(
     x: &[f32],
     z: &[f32],
     i: usize,
@@ -346,7 +371,7 @@ fn judge_b(
 ) -> PointStatus {
     let (xi, zi) = (x[i], z[i]);
     let mag = (xi.to_bits() & 0x7FFF_FFFF).max(zi.to_bits() & 0x7FFF_FFFF);
-    if mag > MAX_COORD_BITS {
+    if !IN_RANGE && mag > MAX_COORD_BITS {
         return PointStatus::NonFinite;
     }
     if so | to == 0 {
@@ -403,6 +428,10 @@ fn judge_with(x: &[f32], z: &[f32], i: usize, sj: usize, tj: usize, thr: Thresho
 /// [`windows`] and then [`mark_irregular`] on the raw line: returns (capped windows,
 /// irregular, non-finite). On the M4F the judgement runs inside the backward sweep, while
 /// the point and its window are still in registers; elsewhere it is the two calls.
+/// `in_range`: the caller knows every point to be finite and within ±[`MAX_COORD_M`]
+/// (inside a region of interest that lies within it), so the sweep skips that test; the
+/// verdicts are the same.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn windows_marked(
     x: &[f32],
     z: &[f32],
@@ -411,21 +440,25 @@ pub(crate) fn windows_marked(
     t_off: &mut [u8],
     thr: Threshold,
     status: &mut [PointStatus],
+    in_range: bool,
 ) -> (u32, u32, u32) {
     if cfg!(target_pointer_width = "64") {
         let capped = windows(x, z, d2, s_off, t_off);
         let (irr, nf) = mark_irregular(x, z, s_off, t_off, thr, status);
         (capped, irr, nf)
+    } else if in_range {
+        windows_sweeps_marked::<true>(x, z, d2, s_off, t_off, thr, status)
     } else {
-        windows_sweeps_marked(x, z, d2, s_off, t_off, thr, status)
+        windows_sweeps_marked::<false>(x, z, d2, s_off, t_off, thr, status)
     }
 }
 
-/// [`windows_sweeps`] with [`judge`] in the backward sweep.
+/// [`windows_sweeps`] with [`judge`] in the backward sweep; `IN_RANGE` as `in_range` of
+/// [`windows_marked`].
 #[inline(never)] // its own registers (see `mark_irregular`)
 #[cfg_attr(all(not(test), target_pointer_width = "64"), allow(dead_code))]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN counts as beyond, as in `beyond`
-fn windows_sweeps_marked(
+fn windows_sweeps_marked<const IN_RANGE: bool>(
     x: &[f32],
     z: &[f32],
     d2: f32,
@@ -440,9 +473,9 @@ fn windows_sweeps_marked(
     let (mut irregular, mut non_finite) = (0u32, 0u32);
     let mut t = n.saturating_sub(1);
     for j in (0..n).rev() {
-        let (bx, bz) = back_walk(x, z, d2, j, &mut t, &mut capped);
+        let (bx, bz) = back_walk_sliced(x, z, d2, j, &mut t, &mut capped);
         t_off[j] = (t - j) as u8;
-        let st = judge_b(x, z, j, usize::from(s_off[j]), t - j, (bx, bz), thr);
+        let st = judge_b::<IN_RANGE>(x, z, j, usize::from(s_off[j]), t - j, (bx, bz), thr);
         status[j] = st;
         // Set-aside points are rare: a branch, not two branch-free counts per point.
         if st != PointStatus::Kept {
@@ -458,8 +491,12 @@ fn windows_sweeps_marked(
 /// are still in registers; elsewhere it is the two calls. The same values either way
 /// (tested). With `LEAN`, a ρ that [`LowCut::below`] puts below τ_min is not computed:
 /// the point gets τ_min itself (see [`LowCut`]); and on the M4F the sweep also finds the
-/// nadir (`seed::nadir`), returned as `Some(nadir)` (`None`: not searched). The last
-/// value is the number of points without a neighbour on a side (ρ = 0).
+/// nadir (`seed::nadir`), returned as `Some(nadir)` (`None`: not searched), and lists
+/// the points whose ρ it computed (every point with ρ above τ_min among them) in
+/// `exact`, highest index first: their number, `None` when not listed or when `exact`
+/// was too short. The third value is the number of points without a neighbour on a side
+/// (ρ = 0).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn windows_angles<M: Maths, const LEAN: bool>(
     x: &[f32],
     z: &[f32],
@@ -468,13 +505,14 @@ pub(crate) fn windows_angles<M: Maths, const LEAN: bool>(
     t_off: &mut [u8],
     rho: &mut [f32],
     cut: LowCut,
-) -> (u32, Option<Option<usize>>, u32) {
+    exact: &mut [u16],
+) -> (u32, Option<Option<usize>>, u32, Option<usize>) {
     if cfg!(target_pointer_width = "64") {
         let capped = windows(x, z, d2, s_off, t_off);
         let lone = bend_angles::<M, LEAN>(x, z, s_off, t_off, rho, cut);
-        (capped, None, lone)
+        (capped, None, lone, None)
     } else {
-        windows_sweeps_angles::<M, LEAN>(x, z, d2, s_off, t_off, rho, cut)
+        windows_sweeps_angles::<M, LEAN>(x, z, d2, s_off, t_off, rho, cut, exact)
     }
 }
 
@@ -482,6 +520,7 @@ pub(crate) fn windows_angles<M: Maths, const LEAN: bool>(
 #[inline(never)] // its own registers (see `mark_irregular`)
 #[cfg_attr(all(not(test), target_pointer_width = "64"), allow(dead_code))]
 #[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN counts as beyond, as in `beyond`
+#[allow(clippy::too_many_arguments)]
 fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
     x: &[f32],
     z: &[f32],
@@ -490,37 +529,60 @@ fn windows_sweeps_angles<M: Maths, const LEAN: bool>(
     t_off: &mut [u8],
     rho: &mut [f32],
     cut: LowCut,
-) -> (u32, Option<Option<usize>>, u32) {
+    exact: &mut [u16],
+) -> (u32, Option<Option<usize>>, u32, Option<usize>) {
     let n = x.len();
     let (z, s_off, t_off, rho) = (&z[..n], &mut s_off[..n], &mut t_off[..n], &mut rho[..n]);
     let mut capped = forward_sweep(x, z, d2, s_off);
     let mut t = n.saturating_sub(1);
     // The nadir (`seed::nadir`: smallest |x′| with z′ < 0, the first on a tie): walking
-    // backwards, a tie replaces, so the lowest index wins. The points are finite here
-    // (the kernel set the others aside), so +∞ stands for "none yet".
-    let (mut best, mut nadir) = (f32::INFINITY, usize::MAX);
+    // backwards, a tie replaces, so the lowest index wins. Compared as bit patterns: for
+    // |x′| (sign cleared) they order as the floats do, and z′ < 0 is a pattern above
+    // −0's. The points are finite here (the kernel set the others aside), so no |x′| has
+    // the key u32::MAX that stands for "not below the scanner" and for "none yet"; a point
+    // not below the scanner may take `nadir` while `best` is still u32::MAX, and the first
+    // point below it takes it back.
+    let (mut best, mut nadir) = (u32::MAX, usize::MAX);
     let mut lone = 0u32;
+    let mut listed = 0usize;
     for j in (0..n).rev() {
         let (bx, bz) = back_walk(x, z, d2, j, &mut t, &mut capped);
         t_off[j] = (t - j) as u8;
         if LEAN {
-            let ax = math::abs(x[j]);
-            if z[j] < 0.0 && ax <= best {
-                (best, nadir) = (ax, j);
+            let below = z[j].to_bits() > 0x8000_0000;
+            let key = if below {
+                x[j].to_bits() & 0x7FFF_FFFF
+            } else {
+                u32::MAX
+            };
+            if key <= best {
+                (best, nadir) = (key, j);
             }
         }
         let s = j - usize::from(s_off[j]);
         rho[j] = if s == j || t == j {
             lone += 1;
             0.0
+        } else if LEAN {
+            match lean_rho::<M>(x, z, s, j, t, (bx, bz), cut) {
+                Some(r) => {
+                    if let Some(e) = exact.get_mut(listed) {
+                        *e = j as u16;
+                    }
+                    listed += 1;
+                    r
+                }
+                None => cut.floor,
+            }
         } else {
-            lean_or_exact::<M, LEAN>(x, z, s, j, t, (bx, bz), cut)
+            bend_angle_deg_b::<M>(x, z, s, j, t, (bx, bz))
         };
     }
     (
         capped,
-        LEAN.then_some((nadir != usize::MAX).then_some(nadir)),
+        LEAN.then_some((best != u32::MAX).then_some(nadir)),
         lone,
+        (LEAN && listed <= exact.len()).then_some(listed),
     )
 }
 
@@ -619,20 +681,35 @@ fn lean_or_exact<M: Maths, const LEAN: bool>(
     cut: LowCut,
 ) -> f32 {
     if LEAN {
-        let (ax, az) = (x[i] - x[s], z[i] - z[s]);
-        let (bx, bz) = b;
-        let (c, d) = (ax * bz - az * bx, ax * bx + az * bz);
-        if cut.below(math::abs(c), d) {
-            return cut.floor;
-        }
-        let (cs, d) = bend_cs_d(x, z, s, i, t, b);
-        if cut.below(cs, d) {
-            return cut.floor;
-        }
-        rho_deg::<M>(cs, d)
+        lean_rho::<M>(x, z, s, i, t, b, cut).unwrap_or(cut.floor)
     } else {
         bend_angle_deg_b::<M>(x, z, s, i, t, b)
     }
+}
+
+/// The lean half of [`lean_or_exact`]: ρ, or `None` where `cut` puts it certainly below
+/// τ_min.
+#[inline(always)]
+fn lean_rho<M: Maths>(
+    x: &[f32],
+    z: &[f32],
+    s: usize,
+    i: usize,
+    t: usize,
+    b: (f32, f32),
+    cut: LowCut,
+) -> Option<f32> {
+    let (ax, az) = (x[i] - x[s], z[i] - z[s]);
+    let (bx, bz) = b;
+    let (c, d) = (ax * bz - az * bx, ax * bx + az * bz);
+    if cut.below(math::abs(c), d) {
+        return None;
+    }
+    let (cs, d) = bend_cs_d(x, z, s, i, t, b);
+    if cut.below(cs, d) {
+        return None;
+    }
+    Some(rho_deg::<M>(cs, d))
 }
 
 /// The arguments of the bend angle's arctangent at `i` with neighbours `s` and `t` and
@@ -829,11 +906,34 @@ mod tests {
                 let (i1, n1) = mark_irregular(&x[..n], &z[..n], &s1, &t1, thr, &mut st1);
                 let (mut s3, mut t3) = ([0u8; N], [0u8; N]);
                 let mut st3 = [PointStatus::Kept; N];
-                let r3 =
-                    windows_sweeps_marked(&x[..n], &z[..n], d2, &mut s3, &mut t3, thr, &mut st3);
+                let r3 = windows_sweeps_marked::<false>(
+                    &x[..n],
+                    &z[..n],
+                    d2,
+                    &mut s3,
+                    &mut t3,
+                    thr,
+                    &mut st3,
+                );
                 assert_eq!(r3, (c1, i1, n1), "case {case} d2 {d2}");
                 assert_eq!((s3, t3), (s1, t1));
                 assert_eq!(st3[..n], st1[..n], "case {case} d2 {d2}");
+                // Without the range test, the same verdicts where every point is in range.
+                let in_range = x[..n].iter().chain(&z[..n]).all(|v| v.abs() <= MAX_COORD_M);
+                if in_range {
+                    let mut st4 = [PointStatus::Kept; N];
+                    let (mut s4, mut t4) = ([0u8; N], [0u8; N]);
+                    let r4 = windows_sweeps_marked::<true>(
+                        &x[..n],
+                        &z[..n],
+                        d2,
+                        &mut s4,
+                        &mut t4,
+                        thr,
+                        &mut st4,
+                    );
+                    assert_eq!((r4, st4), (r3, st3), "case {case} d2 {d2}");
+                }
                 // The fused angles give what the separate pass gives.
                 let mut rho1 = [0f32; N];
                 let lone1 = bend_angles::<Selected, false>(
@@ -845,7 +945,7 @@ mod tests {
                     LowCut::NONE,
                 );
                 let (mut s4, mut t4, mut rho4) = ([0u8; N], [0u8; N], [0f32; N]);
-                let (c4, _, lone4) = windows_sweeps_angles::<Selected, false>(
+                let (c4, _, lone4, _) = windows_sweeps_angles::<Selected, false>(
                     &x[..n],
                     &z[..n],
                     d2,
@@ -853,6 +953,7 @@ mod tests {
                     &mut t4,
                     &mut rho4[..n],
                     LowCut::NONE,
+                    &mut [],
                 );
                 assert_eq!(c4, c1, "case {case} d2 {d2}");
                 assert_eq!(lone4, lone1, "case {case} d2 {d2}");
@@ -870,7 +971,8 @@ mod tests {
                 let mut rho5 = [0f32; N];
                 bend_angles::<Selected, true>(&x[..n], &z[..n], &s1, &t1, &mut rho5[..n], cut);
                 let (mut s6, mut t6, mut rho6) = ([0u8; N], [0u8; N], [0f32; N]);
-                let (_, nd, _) = windows_sweeps_angles::<Selected, true>(
+                let mut exact = [0u16; N];
+                let (_, nd, _, listed) = windows_sweeps_angles::<Selected, true>(
                     &x[..n],
                     &z[..n],
                     d2,
@@ -878,7 +980,32 @@ mod tests {
                     &mut t6,
                     &mut rho6[..n],
                     cut,
+                    &mut exact,
                 );
+                // The list holds every point with ρ above τ_min, highest index first.
+                let listed = &exact[..listed.expect("a list as long as the line")];
+                assert!(listed.windows(2).all(|w| w[0] > w[1]), "case {case}");
+                for (i, r) in rho6[..n].iter().enumerate() {
+                    if *r > cut.floor {
+                        assert!(listed.contains(&(i as u16)), "case {case} i {i}");
+                    }
+                }
+                // A list too short says so.
+                if listed.len() > 1 {
+                    let mut short = [0u16; 1];
+                    let (mut s7, mut t7, mut rho7) = ([0u8; N], [0u8; N], [0f32; N]);
+                    let r = windows_sweeps_angles::<Selected, true>(
+                        &x[..n],
+                        &z[..n],
+                        d2,
+                        &mut s7,
+                        &mut t7,
+                        &mut rho7[..n],
+                        cut,
+                        &mut short,
+                    );
+                    assert_eq!(r.3, None, "case {case}");
+                }
                 if case % 3 != 1 && !(case % 4 != 0 && case % 5 == 2) {
                     // Finite points in range only: the sweep's nadir is `seed::nadir`'s.
                     assert_eq!(nd, Some(super::super::seed::nadir(&x[..n], &z[..n])));

@@ -33,14 +33,15 @@
 //! ([`bend::LowCut`]), the region's points compacted rather than partitioned, the kept
 //! points' partition not undone (only the three indices mapped back), no per-point
 //! statuses, the nadir and the points without a neighbour found inside the smoothed pass's
-//! sweep, and the peak pass looking only at points whose ρ is above τ_min. The packet is the same byte
-//! for byte (tested, and compared on whole streams by `firmware/check.sh`).
+//! sweep, and the peak pass looking only at points whose ρ is above τ_min (on the M4F those
+//! the sweep lists as computed). The packet is the same byte for byte (tested, and compared on whole streams by `firmware/check.sh`).
 //!
 //! # Memory
 //!
 //! Per point of capacity `N`: the line's x′, z′, tag (12 bytes) plus the kernel's ρ (`f32`),
 //! status (`u8`) and two `u8` of working space (the window's ends as offsets; the right one
-//! later holds the status of a kept point) — 19 bytes — plus a 1 KiB deque for the peak search and the parameters.
+//! later holds the status of a kept point) — 19 bytes — plus a 1 KiB deque for the peak search,
+//! the lean pass's list of points with an exact ρ (512 bytes) and the parameters.
 //! ρ's buffer doubles as the smoothing scratch before ρ is computed.
 
 use crate::math::{self, Maths};
@@ -155,6 +156,10 @@ pub struct ScanlineOutput<'a> {
     pub output_mode: OutputMode,
 }
 
+/// Length of [`Kernel`]'s list of points with an exact ρ in a lean pass; a line with more
+/// of them has its peaks found by a scan of ρ instead (the same result).
+const EXACT_LEN: usize = 256;
+
 /// Values derived from the parameters once, not per line.
 #[derive(Clone, Copy, Debug)]
 struct Derived {
@@ -202,6 +207,9 @@ pub struct Kernel<const N: usize> {
 
     /// The peak search's window-maximum deque.
     deque: [u16; seed::DEQUE_LEN],
+    /// The points whose ρ a lean pass computed (`bend::windows_angles`), for the peak
+    /// search to visit instead of scanning ρ.
+    exact: [u16; EXACT_LEN],
     /// `params_hash` and `derived` are still to be computed from `params` (a kernel made
     /// by the `const` [`Kernel::new`] computes them on its first line).
     fresh: bool,
@@ -228,6 +236,7 @@ impl<const N: usize> Kernel<N> {
             aux: [0; N],
             s_off: [0; N],
             deque: [0; seed::DEQUE_LEN],
+            exact: [0; EXACT_LEN],
             fresh: true,
             lean_rho: false,
         }
@@ -319,8 +328,15 @@ impl<const N: usize> Kernel<N> {
 
         // 1. §2.3–2.4 on the raw line.
         let s_off = &mut self.s_off[..n];
+        // Inside a region that lies within ±MAX_COORD_M every point is in range.
+        let in_range = p.roi().is_some_and(|r| {
+            let m = bend::MAX_COORD_M;
+            [r.x_min, r.x_max, r.z_min, r.z_max]
+                .iter()
+                .all(|v| (-m..=m).contains(v))
+        });
         let (capped, irr, non_finite) =
-            bend::windows_marked(x, z, d2, s_off, aux, irregular, status);
+            bend::windows_marked(x, z, d2, s_off, aux, irregular, status, in_range);
         c.capped_windows += capped;
         c.irregular = irr;
         c.non_finite = non_finite;
@@ -355,10 +371,12 @@ impl<const N: usize> Kernel<N> {
         // 4. ρ on the smoothed line.
         let s_off = &mut s_off[..kept];
         let (t_off, rk) = (&mut aux[..kept], &mut rho[..kept]);
-        let (capped, swept_nadir, lone) = if lean {
-            bend::windows_angles::<M, true>(xk, zk, d2, s_off, t_off, rk, low_cut)
+        let ex = &mut self.exact;
+        let (capped, swept_nadir, lone, listed) = if lean {
+            bend::windows_angles::<M, true>(xk, zk, d2, s_off, t_off, rk, low_cut, ex)
         } else {
-            bend::windows_angles::<M, false>(xk, zk, d2, s_off, t_off, rk, bend::LowCut::NONE)
+            let none = bend::LowCut::NONE;
+            bend::windows_angles::<M, false>(xk, zk, d2, s_off, t_off, rk, none, ex)
         };
         c.capped_windows += capped;
         if !lean {
@@ -386,6 +404,7 @@ impl<const N: usize> Kernel<N> {
             tau_min: p.tau_min_deg,
             tau_max: p.tau_max_deg,
             nadir,
+            exact: listed.map(|k| &self.exact[..k]),
         };
         let seeds = if lean {
             // Statuses of the candidates are Kept (peaks have both neighbours).

@@ -66,6 +66,9 @@ pub(crate) struct SeedArgs<'a> {
     pub tau_max: f32,
     /// The nadir, compact index.
     pub nadir: Option<usize>,
+    /// In a lean pass, the points whose ρ was computed (every point with ρ above τ_min
+    /// among them), highest index first, if listed (`bend::windows_angles`).
+    pub exact: Option<&'a [u16]>,
 }
 
 /// Peak search over the smoothed kept points. `s_off[k]` = k − s(k) and, on entry,
@@ -99,6 +102,7 @@ pub(crate) fn seed_candidates<const STATUS: bool>(
         tau_min,
         tau_max,
         nadir,
+        exact,
     } = args;
     let n = x.len();
     let (rho, s_off, aux) = (&rho[..n], &s_off[..n], &mut aux[..n]);
@@ -109,12 +113,28 @@ pub(crate) fn seed_candidates<const STATUS: bool>(
     let (mut head, mut tail) = (0usize, 0usize);
     let mut next = 0usize;
     let mut at = 0usize;
+    // The listed points, taken from the back (lowest index first).
+    let mut listed = exact.unwrap_or(&[]);
     while at < n {
         if !STATUS {
-            // The next point with ρ above τ_min (a scan of ρ alone).
-            match rho[at..].iter().position(|&r| r > tau_min) {
-                Some(o) => at += o,
-                None => break,
+            if exact.is_some() {
+                // The next listed point (ρ may still be at or below τ_min: tested below).
+                match listed.split_last() {
+                    Some((&k, rest)) => {
+                        at = usize::from(k);
+                        listed = rest;
+                        if at >= n {
+                            break;
+                        }
+                    }
+                    None => break,
+                }
+            } else {
+                // The next point with ρ above τ_min (a scan of ρ alone).
+                match rho[at..].iter().position(|&r| r > tau_min) {
+                    Some(o) => at += o,
+                    None => break,
+                }
             }
         }
         let k = at;
@@ -215,6 +235,7 @@ mod tests {
             tau_min: 35.0,
             tau_max: 150.0,
             nadir,
+            exact: None,
         };
         let seeds = seed_candidates::<true>(args, &mut aux[..n], &mut dq);
         (seeds, aux)
@@ -243,6 +264,50 @@ mod tests {
         // Without a nadir: peaks, but no candidates.
         let (s, _) = peaks_of(&x, &rho, 0.0101, None);
         assert_eq!((s.peaks, s.left, s.right), (3, None, None));
+    }
+
+    #[test]
+    fn a_lean_pass_visiting_listed_points_finds_what_its_scan_finds() {
+        let x: [f32; 16] = core::array::from_fn(|i| -0.4 + 0.05 * i as f32);
+        let z = [-2.0f32; 16];
+        let mut rho = [35.0f32; 16]; // τ_min: a skipped point
+        rho[0] = 0.0; // no neighbour
+        rho[1] = 80.0;
+        rho[2] = 50.0;
+        rho[4] = 60.0;
+        rho[6] = 20.0; // computed, below τ_min
+        rho[10] = 40.0;
+        rho[11] = 45.0;
+        rho[14] = 170.0;
+        let (mut s_off, mut t_off) = ([0u8; 16], [0u8; 16]);
+        windows(&x, &z, 0.0101, &mut s_off, &mut t_off);
+        let run = |exact: Option<&[u16]>| {
+            let mut dq = [0u16; DEQUE_LEN];
+            let mut aux = t_off;
+            let args = SeedArgs {
+                x: &x,
+                z: &z,
+                gap2: 0.09,
+                rho: &rho,
+                s_off: &s_off,
+                tau_min: 35.0,
+                tau_max: 150.0,
+                nadir: Some(8),
+                exact,
+            };
+            seed_candidates::<false>(args, &mut aux, &mut dq)
+        };
+        let scanned = run(None);
+        assert_eq!(
+            (scanned.peaks, scanned.left, scanned.right),
+            (3, Some(11), Some(4))
+        );
+        // Every computed point, highest first, some of them at or below τ_min.
+        assert_eq!(run(Some(&[14, 11, 10, 6, 4, 2, 1])), scanned);
+        // Only those above τ_min.
+        assert_eq!(run(Some(&[14, 11, 10, 4, 2, 1])), scanned);
+        // An empty list: nothing above τ_min, nothing found.
+        assert_eq!(run(Some(&[])).peaks, 0);
     }
 
     #[test]

@@ -245,6 +245,53 @@ fn tick<const P: usize, const K: usize>(w: &mut [[f32; 3]; K], r: &[f32; K], x: 
     x
 }
 
+/// Ramp-up tick `T` of [`fused_block`] (no-op for `T` > `K`): reads input point `T`,
+/// which gives step s its value at T − s for s < T, and step s + 1 its value at T − s − 1
+/// from step s's (older, newer) and that value (the value for step T, whose point 0 is
+/// its fixed end, is not used). `older`, `newer` hold each step's last two values.
+#[inline(always)]
+fn ramp_up<const T: usize, const K: usize>(
+    older: &mut [f32; K],
+    newer: &mut [f32; K],
+    r: &[f32; K],
+    v: &[f32],
+) {
+    if T > K {
+        return;
+    }
+    let mut x = v[T];
+    for s in 0..T {
+        let next = apply(r[s], older[s], newer[s], x);
+        older[s] = newer[s];
+        newer[s] = x;
+        x = next;
+    }
+}
+
+/// Ramp-down tick `U` of [`fused_block`] (no-op for `U` ≥ `K`): `x` is step U's value at
+/// its fixed end e = 0; step s ≥ U moves on to e = s − U, step s + 1 to e = s − U + 1 from
+/// step s's (older, newer) and that value; the last step's value lands in `out[K − U]`.
+#[inline(always)]
+fn ramp_down<const U: usize, const K: usize>(
+    older: &mut [f32; K],
+    newer: &mut [f32; K],
+    r: &[f32; K],
+    x: f32,
+    out: &mut [f32; BLOCK],
+) {
+    if U >= K {
+        return;
+    }
+    let mut x = x;
+    for s in U..K {
+        let next = apply(r[s], older[s], newer[s], x);
+        older[s] = newer[s];
+        newer[s] = x;
+        x = next;
+    }
+    out[K - U] = x;
+}
+
 /// The (older, newer) values of every step after ticks ending at phase `P`.
 #[inline(always)]
 fn state<const P: usize, const K: usize>(w: &[[f32; 3]; K]) -> [[f32; 2]; K] {
@@ -255,26 +302,29 @@ fn state<const P: usize, const K: usize>(w: &[[f32; 3]; K]) -> [[f32; 2]; K] {
 /// at point m is computed exactly as [`step`] computes it, from step s − 1's values at
 /// m − 1, m, m + 1; only the order differs.
 fn fused_block<const K: usize>(v: &mut [f32], b: &Block) {
-    const { assert!(K <= BLOCK) };
+    // The ramps below are written out for blocks of up to 8 steps.
+    const { assert!(K <= BLOCK && BLOCK == 8) };
     let n = v.len();
     debug_assert!(n >= K + 2);
     let r: [f32; K] = core::array::from_fn(|s| b.r(s));
     let g = b.g[K];
     let (first, last) = (v[0], v[n - 1]);
     // Start: before input point K + 1, step s (0 = the input) must hold its values at
-    // K − s − 1 and K − s. Step s's value at m depends on the input up to m + s, so s
-    // steps over the first K + 2 points alone (right end held) are exact there.
-    let mut head_buf = [0f32; BLOCK + 2];
-    let head = &mut head_buf[..K + 2];
-    head.copy_from_slice(&v[..K + 2]);
-    let mut st = [[0f32; 2]; K];
-    for s in 0..K {
-        if s > 0 {
-            step_in_place(head, b, s - 1, first);
-        }
-        st[s] = [head[K - s - 1], head[K - s]];
-    }
-    let mut w: [[f32; 3]; K] = core::array::from_fn(|s| [st[s][0], st[s][1], 0.0]);
+    // K − s − 1 and K − s. The wavefront ramps up to that ([`ramp_up`]): every step's
+    // value at 0 is its fixed end (first·(1/G_s)), and reading input point t = 1..=K
+    // moves steps 0..t on by one point.
+    let mut newer: [f32; K] =
+        core::array::from_fn(|s| if s == 0 { first } else { first * b.inv_g[s] });
+    let mut older = [0f32; K];
+    ramp_up::<1, K>(&mut older, &mut newer, &r, v);
+    ramp_up::<2, K>(&mut older, &mut newer, &r, v);
+    ramp_up::<3, K>(&mut older, &mut newer, &r, v);
+    ramp_up::<4, K>(&mut older, &mut newer, &r, v);
+    ramp_up::<5, K>(&mut older, &mut newer, &r, v);
+    ramp_up::<6, K>(&mut older, &mut newer, &r, v);
+    ramp_up::<7, K>(&mut older, &mut newer, &r, v);
+    ramp_up::<8, K>(&mut older, &mut newer, &r, v);
+    let mut w: [[f32; 3]; K] = core::array::from_fn(|s| [older[s], newer[s], 0.0]);
 
     // The wavefront over input points K + 1 ..= n − 1: every step computes an interior
     // value (t − s − 1 ∈ 1..=n − 2) and the last one is stored at t − K ≥ 1, behind every
@@ -301,27 +351,23 @@ fn fused_block<const K: usize>(v: &mut [f32], b: &Block) {
         state::<0, K>(&w)
     };
 
-    // End: `back[e]` is the current step's value at n − 1 − e. Step s holds its values at
-    // e = s + 1 and e = s; step s + 1 still lacks e = 1..=s, which follow from step s's
-    // values at e − 1 ..= e + 1 with the fixed end at e = 0.
-    let mut back = [0f32; BLOCK + 2];
-    back[0] = last;
-    back[1] = st[0][0];
-    for s in 0..K {
-        let mut next = [0f32; BLOCK + 2];
-        next[0] = last * b.inv_g[s + 1];
-        for e in 1..=s {
-            next[e] = apply(r[s], back[e + 1], back[e], back[e - 1]);
-        }
-        if s + 1 < K {
-            next[s + 1] = st[s + 1][1];
-            next[s + 2] = st[s + 1][0];
-            back = next;
-        } else {
-            for e in 1..=s {
-                v[n - 1 - e] = g * next[e];
-            }
-        }
+    // End: step s holds its values at n − 1 − e for e = s + 1 and e = s; step s + 1
+    // still lacks e = 1..=s. The wavefront ramps down ([`ramp_down`]): step u's next value
+    // is its fixed end at e = 0, which moves steps u + 1..=K on by one point, down to the
+    // last step's value at e = K − u.
+    let [mut older, mut newer] = [0, 1].map(|k| core::array::from_fn::<f32, K, _>(|s| st[s][k]));
+    let mut out = [0f32; BLOCK];
+    ramp_down::<1, K>(&mut older, &mut newer, &r, last * b.inv_g[1], &mut out);
+    ramp_down::<2, K>(&mut older, &mut newer, &r, last * b.inv_g[2], &mut out);
+    ramp_down::<3, K>(&mut older, &mut newer, &r, last * b.inv_g[3], &mut out);
+    ramp_down::<4, K>(&mut older, &mut newer, &r, last * b.inv_g[4], &mut out);
+    ramp_down::<5, K>(&mut older, &mut newer, &r, last * b.inv_g[5], &mut out);
+    ramp_down::<6, K>(&mut older, &mut newer, &r, last * b.inv_g[6], &mut out);
+    ramp_down::<7, K>(&mut older, &mut newer, &r, last * b.inv_g[7], &mut out);
+    // out[e] is the last step's value at e = 1..K.
+    let tail = &mut v[n - K..n - 1];
+    for (e, p) in (1..K).zip(tail.iter_mut().rev()) {
+        *p = g * out[e];
     }
     // The ends were never written: they keep their true values.
 }
@@ -334,6 +380,38 @@ fn smooth_piece(v: &mut [f32], scratch: &mut [f32], steps: u32, b: &Block) {
     } else {
         smooth_piece_fused(v, steps, b);
     }
+}
+
+/// The end of the piece that starts at `start` (< `x.len()`): the first point more than
+/// the gap (`gap2`, squared) from its predecessor, or the line's length.
+#[inline(always)]
+fn piece_end(x: &[f32], z: &[f32], start: usize, gap2: f32) -> usize {
+    let n = x.len();
+    let z = &z[..n];
+    let apart = |(ax, az): (f32, f32), (bx, bz): (f32, f32)| {
+        let (dx, dz) = (bx - ax, bz - az);
+        dx * dx + dz * dz > gap2
+    };
+    // Two points per round, so that the previous point stays in its registers (two
+    // loads per point, no moves).
+    let mut p = (x[start], z[start]);
+    let mut e = start + 1;
+    while e + 1 < n {
+        let c = (x[e], z[e]);
+        if apart(p, c) {
+            return e;
+        }
+        let q = (x[e + 1], z[e + 1]);
+        if apart(c, q) {
+            return e + 1;
+        }
+        p = q;
+        e += 2;
+    }
+    if e < n && apart(p, (x[e], z[e])) {
+        return e;
+    }
+    n
 }
 
 /// Taubin-smooths the line `x`, `z` in place, piece by piece (split where consecutive
@@ -360,19 +438,7 @@ pub(crate) fn taubin_smooth(
     let mut start = 0;
     while start < n {
         let end = if split {
-            // The previous point stays in registers: two loads per point.
-            let (mut px, mut pz) = (x[start], z[start]);
-            let mut e = start + 1;
-            while e < n {
-                let (cx, cz) = (x[e], z[e]);
-                let (dx, dz) = (cx - px, cz - pz);
-                if dx * dx + dz * dz > gap2 {
-                    break;
-                }
-                (px, pz) = (cx, cz);
-                e += 1;
-            }
-            e
+            piece_end(x, z, start, gap2)
         } else {
             n
         };
