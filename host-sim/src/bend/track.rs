@@ -239,6 +239,10 @@ const CUT_MIN_TRACK_STEPS: usize = 10;
 /// [`track_one_way`]): a third of the shortest cut.
 const CUT_MIN_KEEP_M: f64 = 1.0;
 
+/// Farthest a virtual profile's toe may lie from a weak pick to confirm it, metres:
+/// about the scatter of picks across the toe.
+const WEAK_CONFIRM_M: f64 = 0.1;
+
 /// Largest vertical component of the search direction (a grade of about 15 %).
 const MAX_CLIMB: f64 = 0.15;
 
@@ -298,8 +302,15 @@ fn track_one_way(
     let mut cut_run_m = 0.0f64;
     // Index in `picked` of the first vertex of that run.
     let mut cut_from: Option<usize> = None;
+    // Length gone on unconfirmed weak picks and gap steps since the last confirmed toe,
+    // metres, and the index in `picked` where that stretch starts.
+    let mut weak_run_m = 0.0f64;
+    let mut weak_from: Option<usize> = None;
+    let dbg = std::env::var_os("CT_DBG").is_some();
+    let mut kind: &str;
 
     for _ in 0..params.max_steps {
+        kind = "rho";
         // The search position (Fig. 7): one search distance ahead along v.
         let pred = [
             cur[0] + d_s * v[0],
@@ -355,11 +366,13 @@ fn track_one_way(
                     && picked.len() >= CUT_MIN_TRACK_STEPS;
                 match toe {
                     Some(t) => {
+                        kind = "prof";
                         cut_run_m = 0.0;
                         cut_from = None;
                         Some(t)
                     }
                     None if cut_ok => {
+                        kind = "cut";
                         let t = cut_toe(input, grid, c, along, up, 2.0 * l, params);
                         if t.is_some() {
                             cut_run_m += d_s;
@@ -378,12 +391,19 @@ fn track_one_way(
             };
             match found.filter(ahead) {
                 Some(toe) => {
+                    weak_run_m = 0.0;
+                    weak_from = None;
                     let id = *next_virtual;
                     *next_virtual += 1;
                     (id, toe.xyz)
                 }
                 None if gap < params.max_gap_steps => {
                     gap += 1;
+                    weak_run_m += d_s;
+                    weak_from.get_or_insert(picked.len());
+                    if params.weak_run_max_m > 0.0 && weak_run_m > params.weak_run_max_m {
+                        break;
+                    }
                     cur = pred;
                     let (c, sn) = (turn.cos(), turn.sin());
                     v = [c * v[0] - sn * v[1], sn * v[0] + c * v[1], v[2]];
@@ -448,14 +468,54 @@ fn track_one_way(
                     (t.xyz[0] - cur[0]) * along[0] + (t.xyz[1] - cur[1]) * along[1] > 0.25 * d_s
                 }) {
                 Some(toe) => {
+                    weak_run_m = 0.0;
+                    weak_from = None;
                     let id = *next_virtual;
                     *next_virtual += 1;
                     (id, toe.xyz)
                 }
-                None => (n as u32, [input.x[n], input.y[n], input.z[n]]),
+                None => {
+                    // A weak pick counts as the curb only where a virtual profile shows a
+                    // toe beside it; otherwise it adds to the unconfirmed stretch.
+                    let p = [input.x[n], input.y[n], input.z[n]];
+                    if (input.rho_deg[n] as f64) < params.weak_rho_deg
+                        && params.weak_run_max_m > 0.0
+                    {
+                        let near = |t: &ProfileToe| {
+                            (t.xyz[0] - p[0]).hypot(t.xyz[1] - p[1]) <= WEAK_CONFIRM_M
+                        };
+                        let cut_ok = picked.len() >= CUT_MIN_TRACK_STEPS
+                            && params.cut_follow_max_m > 0.0;
+                        let confirmed = profile_toe(input, grid, c, along, up, 2.0 * l, params)
+                            .filter(near)
+                            .is_some()
+                            || (cut_ok
+                                && cut_toe(input, grid, c, along, up, 2.0 * l, params)
+                                    .filter(near)
+                                    .is_some());
+                        if confirmed {
+                            weak_run_m = 0.0;
+                            weak_from = None;
+                        } else {
+                            weak_run_m += (p[0] - cur[0]).hypot(p[1] - cur[1]);
+                            weak_from.get_or_insert(picked.len());
+                            if weak_run_m > params.weak_run_max_m {
+                                break;
+                            }
+                        }
+                    } else {
+                        weak_run_m = 0.0;
+                        weak_from = None;
+                    }
+                    (n as u32, p)
+                }
             }
         };
         let (n, p) = next;
+        if dbg {
+            let r = if (n as usize) < input.x.len() { input.rho_deg[n as usize] } else { -1.0 };
+            eprintln!("TRK {own} {kind} {:.2} {:.2} {:.3} {r:.1} gap{gap}", p[0], p[1], p[2]);
+        }
         if let Some(j) = claims.near(n, p[0], p[1], own) {
             return (picked, Some(j));
         }
@@ -489,6 +549,10 @@ fn track_one_way(
     // prediction happened to meet, not a cut followed: it is dropped, so that the track
     // ends where the curb did (and its end's tangent, which a bridge reads, is the curb's).
     if let Some(k) = cut_from.filter(|_| cut_run_m < CUT_MIN_KEEP_M) {
+        picked.truncate(k);
+    }
+    // Nor does a track end in a stretch no toe confirms: it ends at its last curb.
+    if let Some(k) = weak_from {
         picked.truncate(k);
     }
     (picked, None)
