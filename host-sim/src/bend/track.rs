@@ -492,13 +492,13 @@ fn track_one_way(
                         let near = |t: &ProfileToe| {
                             (t.xyz[0] - p[0]).hypot(t.xyz[1] - p[1]) <= WEAK_CONFIRM_M
                         };
-                        let cut_ok = picked.len() >= CUT_MIN_TRACK_STEPS
-                            && params.cut_follow_max_m > 0.0;
+                        let cut_ok =
+                            picked.len() >= CUT_MIN_TRACK_STEPS && params.cut_follow_max_m > 0.0;
                         let confirmed = side_step(input, grid, n, along)
                             .is_some_and(|d| d * up >= WEAK_CONFIRM_STEP_M)
                             || profile_toe(input, grid, c, along, up, 2.0 * l, params)
-                            .filter(near)
-                            .is_some()
+                                .filter(near)
+                                .is_some()
                             || (cut_ok
                                 && cut_toe(input, grid, c, along, up, 2.0 * l, params)
                                     .filter(near)
