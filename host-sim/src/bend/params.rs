@@ -111,6 +111,17 @@ pub struct BendParams {
     /// far side to bridge to (the end of the drive, a cut beside a side street) it was
     /// lost. 15 m is a 12 m cut with both transitions.
     pub cut_follow_max_m: f64,
+    /// Bend angle, degrees, under which a picked toe is *weak*: road noise reaches it.
+    /// Not in the paper; the kernel's τ_min (30°), under which it gives no seed candidate.
+    /// A weak pick counts as the curb only where a virtual profile confirms it
+    /// (`profile::profile_toe` or `profile::cut_toe` beside it).
+    pub weak_rho_deg: f64,
+    /// Longest stretch, metres, a track goes on unconfirmed weak picks and gap steps
+    /// before it stops and drops that stretch (0 = no limit). Not in the paper: on a flat
+    /// road the bend angle's noise reaches 10–25° wherever the lines are sparse or noisy,
+    /// and above the stop threshold a track walks on it from one parked car to the next and
+    /// across the road. 1.5 m is the 0.9 m of gap steps and a little more.
+    pub weak_run_max_m: f64,
     /// Upper bound of steps per track (per direction): a safety net only.
     pub max_steps: u32,
     /// Distance, metres, within which a track is taken to have reached another track (it
@@ -213,6 +224,8 @@ impl Default for BendParams {
             profile_max_slope: 0.1,
             profile_seed_reach_m: 15.0,
             cut_follow_max_m: 15.0,
+            weak_rho_deg: 30.0,
+            weak_run_max_m: 1.5,
             max_steps: 200_000,
             join_distance_m: 0.05,
             bridge_max_m: 12.0,

@@ -188,6 +188,14 @@ pub fn track_edges(
 /// `dir` at point `i`: mean heights of the strips 0.1–0.4 m either side, ±0.3 m along.
 /// `None` when the two differ by less than 20 mm (no step to go by).
 fn up_side(input: &BendInput, grid: &PointGrid, i: usize, dir: [f64; 2]) -> Option<f64> {
+    let diff = side_step(input, grid, i, dir)?;
+    (diff.abs() >= 0.02).then_some(diff.signum())
+}
+
+/// Mean height of the strip 0.1–0.4 m left of the horizontal direction `dir` at point `i`
+/// less that of the strip as far right, ±0.3 m along, metres; `None` where either strip
+/// holds fewer than 3 points.
+fn side_step(input: &BendInput, grid: &PointGrid, i: usize, dir: [f64; 2]) -> Option<f64> {
     let l = dir[0].hypot(dir[1]);
     if l.is_nan() || l <= 1e-9 {
         return None;
@@ -217,8 +225,7 @@ fn up_side(input: &BendInput, grid: &PointGrid, i: usize, dir: [f64; 2]) -> Opti
     if nl < 3 || nr < 3 {
         return None;
     }
-    let diff = sl / nl as f64 - sr / nr as f64;
-    (diff.abs() >= 0.02).then_some(diff.signum())
+    Some(sl / nl as f64 - sr / nr as f64)
 }
 
 /// Weight of the newest step in the running turn per step (an exponential moving average
@@ -238,6 +245,15 @@ const CUT_MIN_TRACK_STEPS: usize = 10;
 /// Shortest run on curb-cut toes kept at the end of a track, metres (see
 /// [`track_one_way`]): a third of the shortest cut.
 const CUT_MIN_KEEP_M: f64 = 1.0;
+
+/// Farthest a virtual profile's toe may lie from a weak pick to confirm it, metres:
+/// about the scatter of picks across the toe.
+const WEAK_CONFIRM_M: f64 = 0.1;
+
+/// Least height step across a weak pick that confirms it as a toe, metres (the ground
+/// 0.1–0.4 m beside it on the curb side above that on the road side): under a 60 mm curb,
+/// above a road's crossfall over that width.
+const WEAK_CONFIRM_STEP_M: f64 = 0.03;
 
 /// Largest vertical component of the search direction (a grade of about 15 %).
 const MAX_CLIMB: f64 = 0.15;
@@ -298,6 +314,10 @@ fn track_one_way(
     let mut cut_run_m = 0.0f64;
     // Index in `picked` of the first vertex of that run.
     let mut cut_from: Option<usize> = None;
+    // Length gone on unconfirmed weak picks and gap steps since the last confirmed toe,
+    // metres, and the index in `picked` where that stretch starts.
+    let mut weak_run_m = 0.0f64;
+    let mut weak_from: Option<usize> = None;
 
     for _ in 0..params.max_steps {
         // The search position (Fig. 7): one search distance ahead along v.
@@ -378,12 +398,19 @@ fn track_one_way(
             };
             match found.filter(ahead) {
                 Some(toe) => {
+                    weak_run_m = 0.0;
+                    weak_from = None;
                     let id = *next_virtual;
                     *next_virtual += 1;
                     (id, toe.xyz)
                 }
                 None if gap < params.max_gap_steps => {
                     gap += 1;
+                    weak_run_m += d_s;
+                    weak_from.get_or_insert(picked.len());
+                    if params.weak_run_max_m > 0.0 && weak_run_m > params.weak_run_max_m {
+                        break;
+                    }
                     cur = pred;
                     let (c, sn) = (turn.cos(), turn.sin());
                     v = [c * v[0] - sn * v[1], sn * v[0] + c * v[1], v[2]];
@@ -448,11 +475,50 @@ fn track_one_way(
                     (t.xyz[0] - cur[0]) * along[0] + (t.xyz[1] - cur[1]) * along[1] > 0.25 * d_s
                 }) {
                 Some(toe) => {
+                    weak_run_m = 0.0;
+                    weak_from = None;
                     let id = *next_virtual;
                     *next_virtual += 1;
                     (id, toe.xyz)
                 }
-                None => (n as u32, [input.x[n], input.y[n], input.z[n]]),
+                None => {
+                    // A weak pick counts as the curb only where the ground steps up beside it
+                    // or a virtual profile shows a toe there; otherwise it adds to the
+                    // unconfirmed stretch.
+                    let p = [input.x[n], input.y[n], input.z[n]];
+                    if (input.rho_deg[n] as f64) < params.weak_rho_deg
+                        && params.weak_run_max_m > 0.0
+                    {
+                        let near = |t: &ProfileToe| {
+                            (t.xyz[0] - p[0]).hypot(t.xyz[1] - p[1]) <= WEAK_CONFIRM_M
+                        };
+                        let cut_ok =
+                            picked.len() >= CUT_MIN_TRACK_STEPS && params.cut_follow_max_m > 0.0;
+                        let confirmed = side_step(input, grid, n, along)
+                            .is_some_and(|d| d * up >= WEAK_CONFIRM_STEP_M)
+                            || profile_toe(input, grid, c, along, up, 2.0 * l, params)
+                                .filter(near)
+                                .is_some()
+                            || (cut_ok
+                                && cut_toe(input, grid, c, along, up, 2.0 * l, params)
+                                    .filter(near)
+                                    .is_some());
+                        if confirmed {
+                            weak_run_m = 0.0;
+                            weak_from = None;
+                        } else {
+                            weak_run_m += (p[0] - cur[0]).hypot(p[1] - cur[1]);
+                            weak_from.get_or_insert(picked.len());
+                            if weak_run_m > params.weak_run_max_m {
+                                break;
+                            }
+                        }
+                    } else {
+                        weak_run_m = 0.0;
+                        weak_from = None;
+                    }
+                    (n as u32, p)
+                }
             }
         };
         let (n, p) = next;
@@ -489,6 +555,10 @@ fn track_one_way(
     // prediction happened to meet, not a cut followed: it is dropped, so that the track
     // ends where the curb did (and its end's tangent, which a bridge reads, is the curb's).
     if let Some(k) = cut_from.filter(|_| cut_run_m < CUT_MIN_KEEP_M) {
+        picked.truncate(k);
+    }
+    // Nor does a track end in a stretch no toe confirms: it ends at its last curb.
+    if let Some(k) = weak_from {
         picked.truncate(k);
     }
     (picked, None)
@@ -595,7 +665,7 @@ mod tests {
         let inp = input(c);
         let grid = PointGrid::build(inp.x, inp.y, 0.1, |_| true);
         let seed = (0..c.x.len())
-            .filter(|&i| c.rho[i] > 30.0)
+            .filter(|&i| c.rho[i] > 10.0)
             .min_by(|&a, &b| (c.x[a] - 3.0).abs().total_cmp(&(c.x[b] - 3.0).abs()))
             .unwrap();
         let seeds = [Seed {
@@ -700,6 +770,77 @@ mod tests {
             &params
         )
         .is_none());
+    }
+
+    /// A curb along y = 5 (sidewalk 0.15 m up beyond it) from x = 0 to `curb_end`, seen by
+    /// scanlines across x every 0.11 m with points every 2 cm; past its end the road is
+    /// flat. Along the line y = 5 every scanline has a point with ρ = `rho_curb` while
+    /// the curb lasts and ρ = 15° (road noise above the stop threshold) after it.
+    fn weak_line(curb_end: f64, rho_curb: f32) -> Corner {
+        let mut c = Corner {
+            x: Vec::new(),
+            y: Vec::new(),
+            z: Vec::new(),
+            t: Vec::new(),
+            rho: Vec::new(),
+            status: Vec::new(),
+            scanline: Vec::new(),
+            traj: Trajectory::default(),
+        };
+        let mut line = 0u32;
+        let mut x = 0.013;
+        while x < 16.0 {
+            let curb = x < curb_end;
+            for k in 0..400 {
+                let y = k as f64 * 0.02;
+                let up = curb && y > 5.0;
+                let on_line = (y - 4.99).abs() < 0.01;
+                c.x.push(x);
+                c.y.push(y);
+                c.z.push(if up { 0.15 } else { 0.0 });
+                c.t.push(line as f64 * 0.01 + y * 1e-5);
+                c.rho.push(match (on_line, curb) {
+                    (false, _) => 0.0,
+                    (true, true) => rho_curb,
+                    (true, false) => 15.0,
+                });
+                c.status.push(Some(PointStatus::Kept));
+                c.scanline.push(line);
+            }
+            x += 0.11;
+            line += 1;
+        }
+        c
+    }
+
+    fn farthest_x(c: &Corner, params: &BendParams) -> f64 {
+        track(c, params)
+            .xyz
+            .iter()
+            .map(|q| q[0])
+            .fold(f64::MIN, f64::max)
+    }
+
+    #[test]
+    fn a_track_stops_where_only_weak_unconfirmed_picks_go_on() {
+        // Past the curb's end the weak line on the flat road is not followed beyond
+        // `weak_run_max_m`, and the unconfirmed stretch is dropped.
+        let c = weak_line(7.0, 60.0);
+        let params = BendParams::default();
+        let far = farthest_x(&c, &params);
+        assert!((6.7..7.5).contains(&far), "stopped at x = {far}");
+        // Without the limit the track walks the noise to the end of the scan.
+        let off = BendParams {
+            weak_run_max_m: 0.0,
+            ..BendParams::default()
+        };
+        let far_off = farthest_x(&c, &off);
+        assert!(far_off > 15.0, "without the limit: x = {far_off}");
+        // A curb whose bend angle is weak all along is still followed: the step beside
+        // the picks confirms them.
+        let low = weak_line(12.0, 15.0);
+        let far_low = farthest_x(&low, &params);
+        assert!((11.7..12.5).contains(&far_low), "weak curb: x = {far_low}");
     }
 
     #[test]
