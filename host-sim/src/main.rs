@@ -36,6 +36,10 @@ enum Command {
 }
 
 fn main() {
+    // Output piped into a reader that stops early (`curbtrace eval … | head`) ends the
+    // program quietly, as other command-line tools do, instead of a panic on EPIPE.
+    // SAFETY: resets one signal's disposition before any thread starts.
+    unsafe { libc::signal(libc::SIGPIPE, libc::SIG_DFL) };
     curbtrace_host_sim::stream::malloc::one_arena();
     let cli = Cli::parse();
     let result = match cli.command {

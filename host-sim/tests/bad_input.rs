@@ -274,3 +274,19 @@ fn points_partly_outside_the_trajectory_are_dropped_and_counted() {
     assert_eq!(cols.len() as u64 + before + after, info.points_selected);
     assert!(cols.t.iter().all(|&t| (t0..=t1).contains(&t)));
 }
+
+/// Output into a pipe whose reader has gone (`curbtrace … | head`) ends the program
+/// quietly, as other command-line tools do: no panic message, no exit code 101.
+#[test]
+fn output_into_a_closed_pipe_ends_quietly() {
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_curbtrace"))
+        .args(["extract", "--print-config"])
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_ne!(out.status.code(), Some(101), "{stderr}");
+}
