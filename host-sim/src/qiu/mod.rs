@@ -174,6 +174,10 @@ fn is_edge_step(c: &Chain, params: &QiuParams) -> bool {
     refine::median_step(c).is_some_and(|h| (params.min_step_m..=params.max_step_m).contains(&h))
 }
 
+/// Most distance between the vertices at which a line's height step is measured, metres:
+/// the line fit leaves long straight stretches with a vertex at either end only.
+const STEP_SAMPLE_M: f64 = 1.0;
+
 /// Seconds of trajectory added before and after a section for nearest-trajectory-point
 /// queries, so points seen ahead of or behind the vehicle still find their foot point.
 const TRACK_PAD_S: f64 = 5.0;
@@ -298,6 +302,9 @@ fn process_section(
     let mut chains = refine::refine_by_continuity(&edge_pts, &width.kept, params);
     let grid = HeightGrid::new(&pts, o);
     for c in &mut chains {
+        if !c.across {
+            *c = refine::densify(c, STEP_SAMPLE_M);
+        }
         let unmeasured = c.across.then(|| c.clone());
         grid.measure_steps(c, params.height_band_m);
         if let Some(mut r) = unmeasured {

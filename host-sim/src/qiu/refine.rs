@@ -691,10 +691,74 @@ pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParam
     join_chains(pieces, params)
 }
 
-/// The median of the finite height steps of a chain's vertices.
+/// The chain with vertices inserted so that none is more than `step` from the next (the
+/// line itself unchanged; stations and height steps interpolated linearly), so that the
+/// height step measured at the vertices samples the whole line, not only its bends.
+pub fn densify(c: &Chain, step: f64) -> Chain {
+    let mut out = Chain {
+        side: c.side,
+        pts: Vec::with_capacity(c.pts.len()),
+        s: Vec::with_capacity(c.pts.len()),
+        h: Vec::with_capacity(c.pts.len()),
+        across: c.across,
+    };
+    for k in 0..c.pts.len() {
+        if k > 0 {
+            let (a, b) = (c.pts[k - 1], c.pts[k]);
+            let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+            let n = (len / step).ceil() as usize;
+            for j in 1..n {
+                let w = j as f64 / n as f64;
+                out.pts.push([
+                    a[0] + w * (b[0] - a[0]),
+                    a[1] + w * (b[1] - a[1]),
+                    a[2] + w * (b[2] - a[2]),
+                ]);
+                out.s.push(c.s[k - 1] + w * (c.s[k] - c.s[k - 1]));
+                out.h.push(c.h[k - 1] + w * (c.h[k] - c.h[k - 1]));
+            }
+        }
+        out.pts.push(c.pts[k]);
+        out.s.push(c.s[k]);
+        out.h.push(c.h[k]);
+    }
+    out
+}
+
+/// The median of the height steps of a chain's vertices (`None` where more than half of
+/// the line is unmeasured), each weighted by the length of line it stands for (half of each segment it ends): the line fit places few
+/// vertices on a long straight curb and many on a short curb cut's bends, so the plain
+/// median of the vertices would call a curb with one cut in it a cut (or no edge).
 pub fn median_step(c: &Chain) -> Option<f64> {
-    let mut hs: Vec<f64> = c.h.iter().copied().filter(|h| h.is_finite()).collect();
-    median(&mut hs)
+    let seg = |k: usize| {
+        let (a, b) = (c.pts[k], c.pts[k + 1]);
+        (b[0] - a[0]).hypot(b[1] - a[1])
+    };
+    let n = c.pts.len();
+    let mut hw: Vec<(f64, f64)> = (0..n)
+        .map(|k| {
+            let before = if k > 0 { seg(k - 1) } else { 0.0 };
+            let after = if k + 1 < n { seg(k) } else { 0.0 };
+            (c.h[k], 0.5 * (before + after))
+        })
+        .collect();
+    let total: f64 = hw.iter().map(|q| q.1).sum();
+    if !(total > 0.0) {
+        let mut hs: Vec<f64> = hw.iter().map(|q| q.0).filter(|h| h.is_finite()).collect();
+        return median(&mut hs);
+    }
+    // Unmeasured stretches (NaN) rank above every measured step: a line whose larger part
+    // cannot be measured has no median step.
+    let rank = |h: f64| if h.is_finite() { h } else { f64::INFINITY };
+    hw.sort_unstable_by(|a, b| rank(a.0).total_cmp(&rank(b.0)));
+    let mut acc = 0.0;
+    for &(h, w) in &hw {
+        acc += w;
+        if acc >= 0.5 * total {
+            return h.is_finite().then_some(h);
+        }
+    }
+    None
 }
 
 /// Cuts a chain to the stations `[a, b]` (the section's core), interpolating a vertex
@@ -933,5 +997,33 @@ mod tests {
         assert_eq!(joined.len(), 1);
         assert!((joined[0].length_m() - 20.0).abs() < 1e-9);
         assert_eq!(joined[0].pts.len(), 4);
+    }
+
+    /// A 16 m curb (a vertex at either end, step 0.23 m) followed by a 5 m curb cut whose
+    /// bends give it six vertices (step 0): the plain median of the vertices is the cut's,
+    /// the length-weighted one the curb's. Densified to 1 m, the curb's stretch is
+    /// sampled along its length; a line mostly unmeasured (NaN) has no median step.
+    #[test]
+    fn the_median_step_weighs_vertices_by_the_line_they_stand_for() {
+        let xs = [0.0, 16.0, 17.0, 18.0, 19.0, 20.0, 21.0];
+        let hs = [0.23, 0.23, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let c = Chain {
+            side: Side::Left,
+            pts: xs.iter().map(|&x| [x, 5.0, 0.0]).collect(),
+            s: xs.to_vec(),
+            h: hs.to_vec(),
+            across: false,
+        };
+        assert_eq!(median(&mut hs.to_vec()), Some(0.0));
+        assert_eq!(median_step(&c), Some(0.23));
+        let d = densify(&c, 1.0);
+        assert_eq!(d.pts.len(), 22);
+        assert!(d.pts.windows(2).all(|w| (w[1][0] - w[0][0]) <= 1.0 + 1e-12));
+        assert!((d.s[8] - 8.0).abs() < 1e-12 && (d.h[8] - 0.23).abs() < 1e-12);
+        let mut unmeasured = d.clone();
+        for h in &mut unmeasured.h[..14] {
+            *h = f64::NAN;
+        }
+        assert_eq!(median_step(&unmeasured), None);
     }
 }
