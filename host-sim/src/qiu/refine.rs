@@ -743,7 +743,7 @@ pub fn median_step(c: &Chain) -> Option<f64> {
         })
         .collect();
     let total: f64 = hw.iter().map(|q| q.1).sum();
-    if !(total > 0.0) {
+    if total.is_nan() || total <= 0.0 {
         let mut hs: Vec<f64> = hw.iter().map(|q| q.0).filter(|h| h.is_finite()).collect();
         return median(&mut hs);
     }
