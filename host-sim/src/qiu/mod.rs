@@ -169,10 +169,21 @@ pub fn extract_edges_with_report(
     (lines, report)
 }
 
-/// A road edge has ground on both sides and a step between `min_step_m` and `max_step_m`.
+/// A road edge has ground on both sides and a step between `min_step_m` and `max_step_m`,
+/// and is no wall joined to a curb: a chain whose measured part steps above `max_step_m`
+/// over `WALL_SHARE_MAX` of its measured length, or that is mostly unmeasured and steps
+/// above `max_step_m` anywhere, is a wall with a little curb (or ground) at its foot.
 fn is_edge_step(c: &Chain, params: &QiuParams) -> bool {
-    refine::median_step(c).is_some_and(|h| (params.min_step_m..=params.max_step_m).contains(&h))
+    let in_range = refine::median_step(c)
+        .is_some_and(|h| (params.min_step_m..=params.max_step_m).contains(&h));
+    let (measured, wall) = refine::measured_and_wall_shares(c, params.max_step_m);
+    let walled = wall > WALL_SHARE_MAX * measured || (measured < 0.5 && wall > 0.0);
+    in_range && !walled
 }
+
+/// Most share of a road edge's measured length whose step may be wall-sized: the corner
+/// of a curb at a building front picks up a few wall-height steps.
+const WALL_SHARE_MAX: f64 = 0.25;
 
 /// Most distance between the vertices at which a line's height step is measured, metres:
 /// the line fit leaves long straight stretches with a vertex at either end only.

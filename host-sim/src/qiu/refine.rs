@@ -725,40 +725,60 @@ pub fn densify(c: &Chain, step: f64) -> Chain {
     out
 }
 
-/// The median of the height steps of a chain's vertices (`None` where more than half of
-/// the line is unmeasured), each weighted by the length of line it stands for (half of each segment it ends): the line fit places few
-/// vertices on a long straight curb and many on a short curb cut's bends, so the plain
-/// median of the vertices would call a curb with one cut in it a cut (or no edge).
-pub fn median_step(c: &Chain) -> Option<f64> {
+/// Each vertex's height step with the length of line it stands for (half of each segment
+/// it ends), metres.
+fn weighted_steps(c: &Chain) -> Vec<(f64, f64)> {
     let seg = |k: usize| {
         let (a, b) = (c.pts[k], c.pts[k + 1]);
         (b[0] - a[0]).hypot(b[1] - a[1])
     };
     let n = c.pts.len();
-    let mut hw: Vec<(f64, f64)> = (0..n)
+    (0..n)
         .map(|k| {
             let before = if k > 0 { seg(k - 1) } else { 0.0 };
             let after = if k + 1 < n { seg(k) } else { 0.0 };
             (c.h[k], 0.5 * (before + after))
         })
+        .collect()
+}
+
+/// The median of the measured height steps of a chain's vertices (`None` where none is
+/// measured), each weighted by the length of line it stands for: the line fit places few
+/// vertices on a long straight curb and many on a short curb cut's bends, so the plain
+/// median of the vertices would call a curb with one cut in it a cut (or no edge).
+pub fn median_step(c: &Chain) -> Option<f64> {
+    let mut hw: Vec<(f64, f64)> = weighted_steps(c)
+        .into_iter()
+        .filter(|q| q.0.is_finite())
         .collect();
     let total: f64 = hw.iter().map(|q| q.1).sum();
     if total.is_nan() || total <= 0.0 {
-        let mut hs: Vec<f64> = hw.iter().map(|q| q.0).filter(|h| h.is_finite()).collect();
+        let mut hs: Vec<f64> = hw.iter().map(|q| q.0).collect();
         return median(&mut hs);
     }
-    // Unmeasured stretches (NaN) rank above every measured step: a line whose larger part
-    // cannot be measured has no median step.
-    let rank = |h: f64| if h.is_finite() { h } else { f64::INFINITY };
-    hw.sort_unstable_by(|a, b| rank(a.0).total_cmp(&rank(b.0)));
+    hw.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
     let mut acc = 0.0;
     for &(h, w) in &hw {
         acc += w;
         if acc >= 0.5 * total {
-            return h.is_finite().then_some(h);
+            return Some(h);
         }
     }
-    None
+    hw.last().map(|q| q.0)
+}
+
+/// The shares of a chain's length whose height step is measured and whose measured step
+/// is above `wall_m` (a wall or a building front, not a curb), each a fraction of the
+/// whole length; `(0, 0)` for a chain without length.
+pub fn measured_and_wall_shares(c: &Chain, wall_m: f64) -> (f64, f64) {
+    let hw = weighted_steps(c);
+    let total: f64 = hw.iter().map(|q| q.1).sum();
+    if total.is_nan() || total <= 0.0 {
+        return (0.0, 0.0);
+    }
+    let measured: f64 = hw.iter().filter(|q| q.0.is_finite()).map(|q| q.1).sum();
+    let wall: f64 = hw.iter().filter(|q| q.0 > wall_m).map(|q| q.1).sum();
+    (measured / total, wall / total)
 }
 
 /// Cuts a chain to the stations `[a, b]` (the section's core), interpolating a vertex
@@ -1002,7 +1022,7 @@ mod tests {
     /// A 16 m curb (a vertex at either end, step 0.23 m) followed by a 5 m curb cut whose
     /// bends give it six vertices (step 0): the plain median of the vertices is the cut's,
     /// the length-weighted one the curb's. Densified to 1 m, the curb's stretch is
-    /// sampled along its length; a line mostly unmeasured (NaN) has no median step.
+    /// sampled along its length; unmeasured (NaN) vertices do not count in the median.
     #[test]
     fn the_median_step_weighs_vertices_by_the_line_they_stand_for() {
         let xs = [0.0, 16.0, 17.0, 18.0, 19.0, 20.0, 21.0];
@@ -1024,6 +1044,11 @@ mod tests {
         for h in &mut unmeasured.h[..14] {
             *h = f64::NAN;
         }
-        assert_eq!(median_step(&unmeasured), None);
+        // The measured vertices (x 14..21, standing for x 13.5..21: 3 m of curb, 4.5 m of
+        // cut) have the cut's median.
+        assert_eq!(median_step(&unmeasured), Some(0.0));
+        let (measured, wall) = measured_and_wall_shares(&unmeasured, 0.2);
+        assert!((measured - 7.5 / 21.0).abs() < 1e-9, "{measured}");
+        assert!((wall - 3.0 / 21.0).abs() < 1e-9, "{wall}");
     }
 }
