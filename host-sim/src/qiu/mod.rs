@@ -169,10 +169,25 @@ pub fn extract_edges_with_report(
     (lines, report)
 }
 
-/// A road edge has ground on both sides and a step between `min_step_m` and `max_step_m`.
+/// A road edge has ground on both sides and a step between `min_step_m` and `max_step_m`,
+/// and is no wall joined to a curb: a chain whose measured part steps above `max_step_m`
+/// over `WALL_SHARE_MAX` of its measured length, or that is mostly unmeasured and steps
+/// above `max_step_m` anywhere, is a wall with a little curb (or ground) at its foot.
 fn is_edge_step(c: &Chain, params: &QiuParams) -> bool {
-    refine::median_step(c).is_some_and(|h| (params.min_step_m..=params.max_step_m).contains(&h))
+    let in_range = refine::median_step(c)
+        .is_some_and(|h| (params.min_step_m..=params.max_step_m).contains(&h));
+    let (measured, wall) = refine::measured_and_wall_shares(c, params.max_step_m);
+    let walled = wall > WALL_SHARE_MAX * measured || (measured < 0.5 && wall > 0.0);
+    in_range && !walled
 }
+
+/// Most share of a road edge's measured length whose step may be wall-sized: the corner
+/// of a curb at a building front picks up a few wall-height steps.
+const WALL_SHARE_MAX: f64 = 0.25;
+
+/// Most distance between the vertices at which a line's height step is measured, metres:
+/// the line fit leaves long straight stretches with a vertex at either end only.
+const STEP_SAMPLE_M: f64 = 1.0;
 
 /// Seconds of trajectory added before and after a section for nearest-trajectory-point
 /// queries, so points seen ahead of or behind the vehicle still find their foot point.
@@ -261,6 +276,7 @@ fn process_section(
         params.energy_tolerance,
         params.energy_slack_m,
         params.noise_count_ratio,
+        [params.low_beta_corridor_m, params.low_beta_window_m],
         params.seed ^ (sec.index as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15),
         &|i| locate(i).map(|p| (p.s, p.d)),
     );
@@ -297,7 +313,22 @@ fn process_section(
     let mut chains = refine::refine_by_continuity(&edge_pts, &width.kept, params);
     let grid = HeightGrid::new(&pts, o);
     for c in &mut chains {
+        if !c.across {
+            *c = refine::densify(c, STEP_SAMPLE_M);
+        }
+        let unmeasured = c.across.then(|| c.clone());
         grid.measure_steps(c, params.height_band_m);
+        if let Some(mut r) = unmeasured {
+            // A line across the trajectory is ordered by offset; which of its sides is the
+            // road is not known from that: the one the other side stands above.
+            r.pts.reverse();
+            r.s.reverse();
+            grid.measure_steps(&mut r, params.height_band_m);
+            let step = |c: &Chain| refine::median_step(c).unwrap_or(f64::NEG_INFINITY);
+            if step(&r) > step(c) {
+                *c = r;
+            }
+        }
     }
     // Ground on both sides (see `QiuParams::min_step_m`), then §3.4.2 step 4.
     chains.retain(|c| is_edge_step(c, params));
@@ -606,6 +637,56 @@ mod tests {
             c >= 95.0 && p >= 95.0,
             "completeness {c} %, correctness {p} %"
         );
+    }
+
+    /// A 10 m curb cut with a 30 mm lip in a 150 mm curb, on a road with 9 mm of height
+    /// noise, where the chosen β is 0.03 m or more (the lip at the edge of its reach) and
+    /// the cut is longer than the joins bridge (`join_gap_m`): with the smaller βs'
+    /// candidates along the curb's line (`low_beta_corridor_m`) joined in, the cut is
+    /// still one line over 90 % of its length. (The lip's noise reaches β = 0.03 m here,
+    /// so the cut is found without them too; `segment`'s
+    /// `smaller_betas_join_along_the_chosen_line_across_a_cut` holds the rule itself.)
+    #[test]
+    fn a_long_low_lip_cut_in_a_noisy_scan_is_found() {
+        let len = 40.0;
+        let (mut pts, traj) = synthetic_road(len, 5);
+        let mut rng = ChaCha8Rng::seed_from_u64(17);
+        for p in &mut pts {
+            let g: f64 = (0..3).map(|_| rng.gen_range(-0.009..0.009)).sum();
+            p[2] += g;
+            let (x, y) = (p[0] - X0, p[1] - Y0);
+            if (15.0..25.0).contains(&x) && y > 5.0 - 0.02 && y < 7.9 {
+                p[2] = p[2].min(10.03 + g);
+            }
+        }
+        let col = |k: usize| pts.iter().map(|p| p[k]).collect::<Vec<f64>>();
+        let (x, y, z, t) = (col(0), col(1), col(2), col(3));
+        let input = QiuInput {
+            x: &x,
+            y: &y,
+            z: &z,
+            t: &t,
+            trajectory: &traj,
+        };
+        let cut_found = |params: &QiuParams| {
+            let (lines, rep) = extract_edges_with_report(&input, params);
+            let beta = rep.sections[0].beta_m[0].unwrap();
+            let left: Vec<EdgeLine> = lines
+                .iter()
+                .filter(|l| l.side == Side::Left)
+                .cloned()
+                .collect();
+            let hit = (0..=100)
+                .filter(|&k| near_any([X0 + 15.0 + k as f64 * 0.1, Y0 + 5.0], &left, 0.2))
+                .count();
+            (beta, hit as f64 / 101.0)
+        };
+        let (beta, with) = cut_found(&QiuParams::default());
+        assert!(
+            beta >= 0.03,
+            "β {beta}: the lip is within the chosen β's reach"
+        );
+        assert!(with >= 0.9, "cut found over {with}");
     }
 
     /// The regression behind sapporo's 39 % (file path) against 72 % (in memory): not the

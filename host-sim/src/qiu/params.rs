@@ -104,6 +104,24 @@ pub struct QiuParams {
     /// smooth line that E_s alone would choose. Measured on random tuning streets: noise
     /// steps 1.8–5.6, clean steps 1.0–1.35.
     pub noise_count_ratio: f64,
+    /// Per side, candidates of the smaller βs (those not within the noise, see
+    /// `noise_count_ratio`) are added to the chosen β's set where their offset from the
+    /// trajectory is within this of the chosen set's innermost line (the median of its
+    /// innermost offsets within `low_beta_window_m` along the trajectory), metres; 0 turns
+    /// it off. Not in the paper, which keeps one β per section: the β that sees a 150 mm
+    /// curb without the road's noise (0.03–0.05 m on noisy scans) leaves a curb cut's
+    /// 15–40 mm lip below the refined plane's reach, and the cut a gap. 0.3 m: the width
+    /// step's tolerance.
+    pub low_beta_corridor_m: f64,
+    /// Along-track window of the innermost line that [`Self::low_beta_corridor_m`] follows,
+    /// metres: 20 m spans the longest curb cut (12 m and its transitions) with curb on
+    /// either side.
+    pub low_beta_window_m: f64,
+    /// Candidates on lines running across the trajectory (a side street's curb beyond a
+    /// corner) are fitted as lines of their own, ordered by offset (see
+    /// `refine::split_across`). Not in the paper, whose continuity step follows the
+    /// trajectory; `false` gives that.
+    pub split_across: bool,
     /// A road edge has ground on both sides: a chain whose median height step across it
     /// cannot be measured (fewer than 3 points within `height_band_m` on one side, as at
     /// the foot of a wall) or is below this is dropped before the longest chains are
@@ -199,6 +217,9 @@ impl Default for QiuParams {
             energy_tolerance: 0.0,
             energy_slack_m: 0.01,
             noise_count_ratio: 1.5,
+            low_beta_corridor_m: 0.3,
+            low_beta_window_m: 20.0,
+            split_across: true,
             min_step_m: 0.02,
             max_step_m: 0.5,
             width_pair_m: 0.25,
@@ -267,6 +288,8 @@ impl QiuParams {
             ("min_step_m", self.min_step_m),
             ("max_step_m", self.max_step_m),
             ("min_rise_beta", self.min_rise_beta),
+            ("low_beta_corridor_m", self.low_beta_corridor_m),
+            ("low_beta_window_m", self.low_beta_window_m),
         ];
         for (name, v) in nonneg {
             if !(v.is_finite() && v >= 0.0) {

@@ -297,6 +297,10 @@ pub struct Chain {
     pub s: Vec<f64>,
     /// Height step across the line at every vertex, metres (NaN where unknown).
     pub h: Vec<f64>,
+    /// The line runs across the trajectory (a side street's curb beyond a corner), not
+    /// along it: its vertices are ordered by offset, not by station (see
+    /// [`split_across`]).
+    pub across: bool,
 }
 
 impl Chain {
@@ -388,6 +392,7 @@ pub fn fit_segments(
         pts: keep.iter().map(|&k| verts[k]).collect(),
         s: keep.iter().map(|&k| stations[k]).collect(),
         h: vec![f64::NAN; keep.len()],
+        across: false,
     };
     if chain.s.last()? < chain.s.first()? {
         chain.pts.reverse();
@@ -461,7 +466,7 @@ pub fn join_chains(mut pieces: Vec<Chain>, params: &QiuParams) -> Vec<Chain> {
 
 /// §3.4.2 step 4: chains shorter than `min_chain_m` are dropped; of chains on the same
 /// side overlapping along the trajectory by more than `max_chain_overlap` of the shorter
-/// one's extent, only the longest is kept.
+/// one's extent, only the longest is kept (lines across the trajectory are not compared).
 pub fn keep_longest(mut chains: Vec<Chain>, params: &QiuParams) -> Vec<Chain> {
     chains.retain(|c| c.length_m() >= params.min_chain_m);
     chains.sort_by(|a, b| {
@@ -473,10 +478,15 @@ pub fn keep_longest(mut chains: Vec<Chain>, params: &QiuParams) -> Vec<Chain> {
     for c in chains {
         let (a0, a1) = c.s_range();
         let ext = (a1 - a0).max(1e-9);
-        let overlaps = kept.iter().filter(|k| k.side == c.side).any(|k| {
-            let (b0, b1) = k.s_range();
-            (a1.min(b1) - a0.max(b0)).max(0.0) > params.max_chain_overlap * ext
-        });
+        // A line across the trajectory has no station extent to compare.
+        let overlaps = !c.across
+            && kept
+                .iter()
+                .filter(|k| k.side == c.side && !k.across)
+                .any(|k| {
+                    let (b0, b1) = k.s_range();
+                    (a1.min(b1) - a0.max(b0)).max(0.0) > params.max_chain_overlap * ext
+                });
         if !overlaps {
             kept.push(c);
         }
@@ -485,14 +495,138 @@ pub fn keep_longest(mut chains: Vec<Chain>, params: &QiuParams) -> Vec<Chain> {
     kept
 }
 
+/// Cells carrying the local direction of a side's candidates in [`split_across`], metres.
+const DIRECTION_CELL_M: f64 = 0.5;
+/// The local direction is taken over this many cells either side of a point's cell
+/// (2 cells of 0.5 m: a 2.5 m square, long enough for the direction of a curb, short
+/// enough to follow a corner of 3 m radius).
+const DIRECTION_REACH_CELLS: i64 = 2;
+/// A neighbourhood is a line when its spread across its main direction is below this
+/// share of its spread along it (ratio of the covariance's eigenvalues): a curb's band of
+/// candidates gives under 0.01, scattered road noise near 1.
+const LINE_EIGEN_RATIO: f64 = 0.2;
+
+/// Which candidates lie on a line running across the trajectory — a side street's curb
+/// beyond a corner, whose offset grows while its station stands still. Per point of
+/// `members`: `true` when the candidates in the 2.5 m square around it form a line
+/// ([`LINE_EIGEN_RATIO`]) within 45° of the perpendicular from the point to its nearest
+/// trajectory point. Such a line is not a function of the station: summarised along the
+/// cluster's main direction (as [`fit_segments`] does) it collapses into a vertex or two,
+/// and the width step, which compares offsets with the road's, drops it.
+pub fn split_across(pts: &[EdgePoint], members: &[usize]) -> Vec<bool> {
+    let key = |p: &EdgePoint| {
+        (
+            (p.p[0] / DIRECTION_CELL_M).floor() as i64,
+            (p.p[1] / DIRECTION_CELL_M).floor() as i64,
+        )
+    };
+    let mut cells: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    for &i in members {
+        cells.entry(key(&pts[i])).or_default().push(i);
+    }
+    // Per cell: the unit main direction of its neighbourhood, when it is a line.
+    let mut dir: HashMap<(i64, i64), Option<[f64; 2]>> = HashMap::new();
+    for &k in cells.keys() {
+        let r = DIRECTION_REACH_CELLS;
+        let mut near: Vec<[f64; 2]> = Vec::new();
+        for dx in -r..=r {
+            for dy in -r..=r {
+                if let Some(c) = cells.get(&(k.0 + dx, k.1 + dy)) {
+                    near.extend(c.iter().map(|&i| [pts[i].p[0], pts[i].p[1]]));
+                }
+            }
+        }
+        dir.insert(k, line_direction(&near));
+    }
+    members
+        .iter()
+        .map(|&i| {
+            let p = &pts[i];
+            let n = [p.p[0] - p.foot[0], p.p[1] - p.foot[1]];
+            let len = n[0].hypot(n[1]);
+            match dir[&key(p)] {
+                Some(u) if len > 1e-9 => {
+                    (u[0] * n[0] + u[1] * n[1]).abs() / len > std::f64::consts::FRAC_1_SQRT_2
+                }
+                _ => false,
+            }
+        })
+        .collect()
+}
+
+/// The unit main direction of a 2D point set when it is a line (see
+/// [`LINE_EIGEN_RATIO`]); `None` for fewer than 3 points or a blob.
+fn line_direction(xy: &[[f64; 2]]) -> Option<[f64; 2]> {
+    if xy.len() < 3 {
+        return None;
+    }
+    let n = xy.len() as f64;
+    let (mx, my) = xy
+        .iter()
+        .fold((0.0, 0.0), |(a, b), p| (a + p[0] / n, b + p[1] / n));
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for p in xy {
+        let (dx, dy) = (p[0] - mx, p[1] - my);
+        sxx += dx * dx;
+        sxy += dx * dy;
+        syy += dy * dy;
+    }
+    let tr = sxx + syy;
+    let det = sxx * syy - sxy * sxy;
+    let disc = (0.25 * tr * tr - det).max(0.0).sqrt();
+    let (l1, l2) = (0.5 * tr + disc, 0.5 * tr - disc);
+    if !(l1 > 0.0 && l2 <= LINE_EIGEN_RATIO * l1) {
+        return None;
+    }
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    Some([theta.cos(), theta.sin()])
+}
+
+/// The line of a cluster running across the trajectory ([`split_across`]): its points
+/// summarised every `bin_m` of offset by their median x, y, z and station, simplified by
+/// Douglas–Peucker, ordered by growing offset. Which side of it is the road is left to
+/// the height step (see `qiu::extract_edges`).
+pub fn fit_across(pts: &[EdgePoint], members: &[usize], params: &QiuParams) -> Option<Chain> {
+    let mut bins: std::collections::BTreeMap<i64, Vec<usize>> = Default::default();
+    for &i in members {
+        bins.entry((pts[i].d.abs() / params.bin_m).floor() as i64)
+            .or_default()
+            .push(i);
+    }
+    let mut verts = Vec::with_capacity(bins.len());
+    let mut stations = Vec::with_capacity(bins.len());
+    for b in bins.values() {
+        let col = |f: &dyn Fn(&EdgePoint) -> f64| {
+            let mut v: Vec<f64> = b.iter().map(|&i| f(&pts[i])).collect();
+            median(&mut v).unwrap_or(f64::NAN)
+        };
+        verts.push([col(&|p| p.p[0]), col(&|p| p.p[1]), col(&|p| p.p[2])]);
+        stations.push(col(&|p| p.s));
+    }
+    if verts.len() < 2 {
+        return None;
+    }
+    let keep = douglas_peucker(&verts, params.segment_tolerance_m);
+    Some(Chain {
+        side: pts[*members.first()?].side(),
+        pts: keep.iter().map(|&k| verts[k]).collect(),
+        s: keep.iter().map(|&k| stations[k]).collect(),
+        h: vec![f64::NAN; keep.len()],
+        across: true,
+    })
+}
+
 /// §3.4.2 steps 1–3 after the width refinement (`kept`): clusters per side, line segments
 /// per cluster, joined. A cluster of which at least `cluster_keep_share` was kept by the
 /// width step is used whole (its kept points still place the line wherever they are, see
 /// [`fit_segments`]'s `preferred`); of other clusters only the kept points count. Measured
 /// on `kawasaki` (200 mm): completeness 90.1 → 93.6 % (bus bay 70 → 100 %, right-hand
 /// intersection 22 → 76 %), correctness 100 % both; at 50 mm the line is less exact where
-/// only unkept points place it (completeness 84 → 78 %). Step 4 ([`keep_longest`]) follows
-/// once heights are known.
+/// only unkept points place it (completeness 84 → 78 %). Candidates on lines running
+/// across the trajectory ([`split_across`]) are taken out first and fitted on their own
+/// ([`fit_across`]), whether the width step kept them or not: the width step judges
+/// offsets from the trajectory, which such a line does not keep. Step 4
+/// ([`keep_longest`]) follows once heights are known.
 pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParams) -> Vec<Chain> {
     let mut is_kept = vec![false; pts.len()];
     for &i in kept {
@@ -500,14 +634,40 @@ pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParam
     }
     let mut pieces = Vec::new();
     for side in [Side::Left, Side::Right] {
-        // Clusters of all candidates of the side; a cluster mostly kept by the width step
+        let candidates: Vec<usize> = (0..pts.len()).filter(|&i| pts[i].side() == side).collect();
+        let xy_of = |ids: &[usize]| -> Vec<[f64; 2]> {
+            ids.iter().map(|&i| [pts[i].p[0], pts[i].p[1]]).collect()
+        };
+        let mut all = Vec::new();
+        let mut across = Vec::new();
+        for cluster in euclidean_clusters(&xy_of(&candidates), params.cluster_tolerance_m) {
+            let members: Vec<usize> = cluster.iter().map(|&k| candidates[k]).collect();
+            let flags = if params.split_across {
+                split_across(pts, &members)
+            } else {
+                vec![false; members.len()]
+            };
+            for (i, f) in members.into_iter().zip(flags) {
+                if f {
+                    across.push(i);
+                } else {
+                    all.push(i);
+                }
+            }
+        }
+        for c in euclidean_clusters(&xy_of(&across), params.cluster_tolerance_m) {
+            if c.len() < params.min_cluster_points {
+                continue;
+            }
+            let members: Vec<usize> = c.iter().map(|&k| across[k]).collect();
+            pieces.extend(fit_across(pts, &members, params));
+        }
+        // Clusters of the side's other candidates; a cluster mostly kept by the width step
         // is kept whole, so a curb that turns a corner keeps its arc (whose offset leaves
         // the road's width) with the straight part it is joined to; of any other cluster
         // only the kept points count, clustered anew.
-        let all: Vec<usize> = (0..pts.len()).filter(|&i| pts[i].side() == side).collect();
-        let xy: Vec<[f64; 2]> = all.iter().map(|&i| [pts[i].p[0], pts[i].p[1]]).collect();
         let mut groups: Vec<Vec<usize>> = Vec::new();
-        for cluster in euclidean_clusters(&xy, params.cluster_tolerance_m) {
+        for cluster in euclidean_clusters(&xy_of(&all), params.cluster_tolerance_m) {
             let members: Vec<usize> = cluster.iter().map(|&k| all[k]).collect();
             let n_kept = members.iter().filter(|&&i| is_kept[i]).count();
             if n_kept as f64 >= params.cluster_keep_share * members.len() as f64 && n_kept > 0 {
@@ -515,8 +675,7 @@ pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParam
                 continue;
             }
             let sub: Vec<usize> = members.into_iter().filter(|&i| is_kept[i]).collect();
-            let sxy: Vec<[f64; 2]> = sub.iter().map(|&i| [pts[i].p[0], pts[i].p[1]]).collect();
-            for c in euclidean_clusters(&sxy, params.cluster_tolerance_m) {
+            for c in euclidean_clusters(&xy_of(&sub), params.cluster_tolerance_m) {
                 groups.push(c.iter().map(|&k| sub[k]).collect());
             }
         }
@@ -532,10 +691,94 @@ pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParam
     join_chains(pieces, params)
 }
 
-/// The median of the finite height steps of a chain's vertices.
+/// The chain with vertices inserted so that none is more than `step` from the next (the
+/// line itself unchanged; stations and height steps interpolated linearly), so that the
+/// height step measured at the vertices samples the whole line, not only its bends.
+pub fn densify(c: &Chain, step: f64) -> Chain {
+    let mut out = Chain {
+        side: c.side,
+        pts: Vec::with_capacity(c.pts.len()),
+        s: Vec::with_capacity(c.pts.len()),
+        h: Vec::with_capacity(c.pts.len()),
+        across: c.across,
+    };
+    for k in 0..c.pts.len() {
+        if k > 0 {
+            let (a, b) = (c.pts[k - 1], c.pts[k]);
+            let len = (b[0] - a[0]).hypot(b[1] - a[1]);
+            let n = (len / step).ceil() as usize;
+            for j in 1..n {
+                let w = j as f64 / n as f64;
+                out.pts.push([
+                    a[0] + w * (b[0] - a[0]),
+                    a[1] + w * (b[1] - a[1]),
+                    a[2] + w * (b[2] - a[2]),
+                ]);
+                out.s.push(c.s[k - 1] + w * (c.s[k] - c.s[k - 1]));
+                out.h.push(c.h[k - 1] + w * (c.h[k] - c.h[k - 1]));
+            }
+        }
+        out.pts.push(c.pts[k]);
+        out.s.push(c.s[k]);
+        out.h.push(c.h[k]);
+    }
+    out
+}
+
+/// Each vertex's height step with the length of line it stands for (half of each segment
+/// it ends), metres.
+fn weighted_steps(c: &Chain) -> Vec<(f64, f64)> {
+    let seg = |k: usize| {
+        let (a, b) = (c.pts[k], c.pts[k + 1]);
+        (b[0] - a[0]).hypot(b[1] - a[1])
+    };
+    let n = c.pts.len();
+    (0..n)
+        .map(|k| {
+            let before = if k > 0 { seg(k - 1) } else { 0.0 };
+            let after = if k + 1 < n { seg(k) } else { 0.0 };
+            (c.h[k], 0.5 * (before + after))
+        })
+        .collect()
+}
+
+/// The median of the measured height steps of a chain's vertices (`None` where none is
+/// measured), each weighted by the length of line it stands for: the line fit places few
+/// vertices on a long straight curb and many on a short curb cut's bends, so the plain
+/// median of the vertices would call a curb with one cut in it a cut (or no edge).
 pub fn median_step(c: &Chain) -> Option<f64> {
-    let mut hs: Vec<f64> = c.h.iter().copied().filter(|h| h.is_finite()).collect();
-    median(&mut hs)
+    let mut hw: Vec<(f64, f64)> = weighted_steps(c)
+        .into_iter()
+        .filter(|q| q.0.is_finite())
+        .collect();
+    let total: f64 = hw.iter().map(|q| q.1).sum();
+    if total.is_nan() || total <= 0.0 {
+        let mut hs: Vec<f64> = hw.iter().map(|q| q.0).collect();
+        return median(&mut hs);
+    }
+    hw.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    let mut acc = 0.0;
+    for &(h, w) in &hw {
+        acc += w;
+        if acc >= 0.5 * total {
+            return Some(h);
+        }
+    }
+    hw.last().map(|q| q.0)
+}
+
+/// The shares of a chain's length whose height step is measured and whose measured step
+/// is above `wall_m` (a wall or a building front, not a curb), each a fraction of the
+/// whole length; `(0, 0)` for a chain without length.
+pub fn measured_and_wall_shares(c: &Chain, wall_m: f64) -> (f64, f64) {
+    let hw = weighted_steps(c);
+    let total: f64 = hw.iter().map(|q| q.1).sum();
+    if total.is_nan() || total <= 0.0 {
+        return (0.0, 0.0);
+    }
+    let measured: f64 = hw.iter().filter(|q| q.0.is_finite()).map(|q| q.1).sum();
+    let wall: f64 = hw.iter().filter(|q| q.0 > wall_m).map(|q| q.1).sum();
+    (measured / total, wall / total)
 }
 
 /// Cuts a chain to the stations `[a, b]` (the section's core), interpolating a vertex
@@ -597,6 +840,7 @@ pub fn clip_to_stations(c: &Chain, a: f64, b: f64) -> Vec<Chain> {
                 pts: vec![p0],
                 s: vec![st0],
                 h: vec![h0],
+                across: c.across,
             });
         }
         if let Some(ch) = cur.as_mut() {
@@ -695,6 +939,48 @@ mod tests {
         assert!(c.pts.iter().all(|q| (q[1] - 5.0).abs() < 1e-9));
     }
 
+    /// A left curb along the trajectory (y = 5 over x ∈ [0, 20]) that turns a 5 m corner
+    /// into a side street and runs away from the road along x = 25 to y = 22. The width
+    /// step kept only the straight part. The side street's curb is a line of its own,
+    /// across the trajectory, and every metre of it lies within 0.2 m of the output; fitted
+    /// along the cluster's main direction, it collapsed into a vertex or two.
+    #[test]
+    fn a_side_streets_curb_running_away_from_the_road_is_a_line_of_its_own() {
+        let p = QiuParams::default();
+        let mut pts = Vec::new();
+        for k in 0..=200 {
+            pts.push(ep(k as f64 * 0.1, 5.0));
+        }
+        let straight = pts.len();
+        for k in 1..=78 {
+            let t = k as f64 / 78.0 * std::f64::consts::FRAC_PI_2;
+            pts.push(ep(20.0 + 5.0 * t.sin(), 10.0 - 5.0 * t.cos()));
+        }
+        for k in 1..=120 {
+            pts.push(ep(25.0, 10.0 + k as f64 * 0.1));
+        }
+        let kept: Vec<usize> = (0..straight).collect();
+        let chains = keep_longest(refine_by_continuity(&pts, &kept, &p), &p);
+        assert!(chains.iter().any(|c| c.across), "{chains:?}");
+        let near = |x: f64, y: f64| {
+            chains.iter().any(|c| {
+                c.pts.windows(2).any(|w| {
+                    let (a, b) = (w[0], w[1]);
+                    let (ux, uy) = (b[0] - a[0], b[1] - a[1]);
+                    let l2 = ux * ux + uy * uy;
+                    let t = (((x - a[0]) * ux + (y - a[1]) * uy) / l2).clamp(0.0, 1.0);
+                    (x - a[0] - t * ux).hypot(y - a[1] - t * uy) <= 0.2
+                })
+            })
+        };
+        for k in 11..=21 {
+            assert!(near(25.0, k as f64), "side street at y = {k}: {chains:?}");
+        }
+        for k in 1..=19 {
+            assert!(near(k as f64, 5.0), "curb at x = {k}: {chains:?}");
+        }
+    }
+
     #[test]
     fn clipping_cuts_at_the_core_bounds() {
         let c = Chain {
@@ -702,6 +988,7 @@ mod tests {
             pts: vec![[0.0, -5.0, 0.0], [10.0, -5.0, 0.0], [20.0, -5.0, 0.0]],
             s: vec![0.0, 10.0, 20.0],
             h: vec![0.1, 0.2, 0.2],
+            across: false,
         };
         // A single segment crossing the whole range is cut at both ends.
         let one = Chain {
@@ -709,6 +996,7 @@ mod tests {
             pts: vec![[0.0, -5.0, 0.0], [20.0, -5.0, 0.0]],
             s: vec![0.0, 20.0],
             h: vec![0.1, 0.1],
+            across: false,
         };
         let parts = clip_to_stations(&one, 5.0, 15.0);
         assert_eq!(parts.len(), 1);
@@ -729,5 +1017,38 @@ mod tests {
         assert_eq!(joined.len(), 1);
         assert!((joined[0].length_m() - 20.0).abs() < 1e-9);
         assert_eq!(joined[0].pts.len(), 4);
+    }
+
+    /// A 16 m curb (a vertex at either end, step 0.23 m) followed by a 5 m curb cut whose
+    /// bends give it six vertices (step 0): the plain median of the vertices is the cut's,
+    /// the length-weighted one the curb's. Densified to 1 m, the curb's stretch is
+    /// sampled along its length; unmeasured (NaN) vertices do not count in the median.
+    #[test]
+    fn the_median_step_weighs_vertices_by_the_line_they_stand_for() {
+        let xs = [0.0, 16.0, 17.0, 18.0, 19.0, 20.0, 21.0];
+        let hs = [0.23, 0.23, 0.0, 0.0, 0.0, 0.0, 0.0];
+        let c = Chain {
+            side: Side::Left,
+            pts: xs.iter().map(|&x| [x, 5.0, 0.0]).collect(),
+            s: xs.to_vec(),
+            h: hs.to_vec(),
+            across: false,
+        };
+        assert_eq!(median(&mut hs.to_vec()), Some(0.0));
+        assert_eq!(median_step(&c), Some(0.23));
+        let d = densify(&c, 1.0);
+        assert_eq!(d.pts.len(), 22);
+        assert!(d.pts.windows(2).all(|w| (w[1][0] - w[0][0]) <= 1.0 + 1e-12));
+        assert!((d.s[8] - 8.0).abs() < 1e-12 && (d.h[8] - 0.23).abs() < 1e-12);
+        let mut unmeasured = d.clone();
+        for h in &mut unmeasured.h[..14] {
+            *h = f64::NAN;
+        }
+        // The measured vertices (x 14..21, standing for x 13.5..21: 3 m of curb, 4.5 m of
+        // cut) have the cut's median.
+        assert_eq!(median_step(&unmeasured), Some(0.0));
+        let (measured, wall) = measured_and_wall_shares(&unmeasured, 0.2);
+        assert!((measured - 7.5 / 21.0).abs() < 1e-9, "{measured}");
+        assert!((wall - 3.0 / 21.0).abs() < 1e-9, "{wall}");
     }
 }

@@ -259,7 +259,10 @@ pub struct Segmentation {
 /// on that side, the smallest β whose E_s is within `energy_tolerance` (relative) of the
 /// smallest E_s, or whose √E_s is within `energy_slack_m` of the smallest √E_s, wins (with
 /// both 0, the set with the smallest E_s as in the paper; ties go to the smaller β, which
-/// sees lower curbs).
+/// sees lower curbs). `low_beta` = [corridor, window] (metres; corridor 0: off): the
+/// smaller βs' candidates (within the noise excepted) join the chosen set where their
+/// offset is within the corridor of the median of the chosen set's innermost offsets
+/// within the window along the trajectory — a curb cut's low lip beside a curb.
 #[allow(clippy::too_many_arguments)]
 pub fn rough_segmentation(
     pts: &[[f64; 3]],
@@ -274,6 +277,7 @@ pub fn rough_segmentation(
     energy_tolerance: f64,
     energy_slack_m: f64,
     noise_count_ratio: f64,
+    low_beta: [f64; 2],
     seed: u64,
     position_of: &dyn Fn(usize) -> Option<(f64, f64)>,
 ) -> Segmentation {
@@ -320,6 +324,7 @@ pub fn rough_segmentation(
             }
         }
     }
+    let mut in_set = vec![false; pts.len()];
     for (side, mut sets) in sets.into_iter().enumerate() {
         // The smallest βs lie within the noise while their candidate count is more than
         // `noise_count_ratio` times the next larger β's: noise outliers fill the road, an
@@ -334,17 +339,75 @@ pub fn rough_segmentation(
             continue;
         };
         let limit = (e_min * (1.0 + energy_tolerance)).max((e_min.sqrt() + energy_slack_m).powi(2));
-        if let Some((_, beta, cand)) = sets
-            .into_iter()
-            .filter(|s| s.0 <= limit)
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-        {
-            out.beta_m[side] = Some(beta);
-            out.candidates.extend(cand);
+        let Some(k) = (0..sets.len())
+            .filter(|&k| sets[k].0 <= limit)
+            .min_by(|&a, &b| sets[a].1.total_cmp(&sets[b].1))
+        else {
+            continue;
+        };
+        let beta = sets[k].1;
+        out.beta_m[side] = Some(beta);
+        for &i in &sets[k].2 {
+            in_set[i] = true;
+        }
+        out.candidates.extend(sets[k].2.iter().copied());
+        // The smaller βs' candidates along the chosen set's innermost line.
+        let [corridor, window] = low_beta;
+        if corridor > 0.0 && k > 0 {
+            let line = innermost_line(&sets[k].2, position_of);
+            for set in &sets[..k] {
+                for &i in &set.2 {
+                    if in_set[i] {
+                        continue;
+                    }
+                    if position_of(i)
+                        .is_some_and(|(s, d)| along_line(&line, s, d.abs(), corridor, window))
+                    {
+                        in_set[i] = true;
+                        out.candidates.push(i);
+                    }
+                }
+            }
         }
     }
     out.candidates.sort_unstable();
     out
+}
+
+/// Whether a point at station `s` and offset `d` (absolute) lies within `corridor` of
+/// the median offset of `line` (station, offset; in station order) over `window` of
+/// station centred on `s`; `false` where the window holds no part of the line.
+fn along_line(line: &[(f64, f64)], s: f64, d: f64, corridor: f64, window: f64) -> bool {
+    let lo = line.partition_point(|q| q.0 < s - 0.5 * window);
+    let hi = line.partition_point(|q| q.0 <= s + 0.5 * window);
+    let mut offs: Vec<f64> = line[lo..hi].iter().map(|q| q.1).collect();
+    if offs.is_empty() {
+        return false;
+    }
+    let mid = offs.len() / 2;
+    let (_, m, _) = offs.select_nth_unstable_by(mid, f64::total_cmp);
+    (d - *m).abs() <= corridor
+}
+
+/// The innermost offset (absolute) of `cand` per [`ENERGY_BIN_M`] of station, as
+/// (station of the bin's start, offset), in station order.
+fn innermost_line(
+    cand: &[usize],
+    position_of: &dyn Fn(usize) -> Option<(f64, f64)>,
+) -> Vec<(f64, f64)> {
+    let mut inner: std::collections::BTreeMap<i64, f64> = Default::default();
+    for &i in cand {
+        if let Some((s, d)) = position_of(i) {
+            let e = inner
+                .entry((s / ENERGY_BIN_M).floor() as i64)
+                .or_insert(f64::INFINITY);
+            *e = e.min(d.abs());
+        }
+    }
+    inner
+        .into_iter()
+        .map(|(k, d)| (k as f64 * ENERGY_BIN_M, d))
+        .collect()
 }
 
 #[cfg(test)]
@@ -439,6 +502,26 @@ mod tests {
             vec![0]
         );
         assert!(candidate_edge_points(&pts, &z, &rough, &refined, 0.1, 0.02).is_empty());
+    }
+
+    /// The smaller βs' candidates join along the chosen set's innermost line: in the
+    /// middle of a 10 m curb cut (no line there) the curb's line on either side still
+    /// places the corridor, so the lip's points (0.05 m off the line) join and road noise
+    /// (3 m nearer the vehicle) or a wall (1 m behind) does not; a stretch with no line
+    /// within half the window takes nothing.
+    #[test]
+    fn smaller_betas_join_along_the_chosen_line_across_a_cut() {
+        let line: Vec<(f64, f64)> = (0..80)
+            .map(|k| k as f64 * 0.5)
+            .filter(|s| !(15.0..25.0).contains(s))
+            .map(|s| (s, 5.0))
+            .collect();
+        assert!(along_line(&line, 20.0, 5.05, 0.3, 20.0));
+        assert!(!along_line(&line, 20.0, 2.0, 0.3, 20.0));
+        assert!(!along_line(&line, 20.0, 6.0, 0.3, 20.0));
+        assert!(!along_line(&line, 70.0, 5.0, 0.3, 20.0));
+        // A window shorter than the cut finds no line in its middle.
+        assert!(!along_line(&line, 20.0, 5.05, 0.3, 5.0));
     }
 
     #[test]
