@@ -92,11 +92,13 @@ pub fn extract(
     let info = campaign.info().clone();
     let first = info.files.first().cloned().unwrap_or_default();
     if info.ring.is_none() {
-        // A spinning sensor's points without their ring cannot be cut into scanlines.
-        if let Some(b) = campaign
-            .next_batch(STREAM_BATCH_POINTS)
-            .map_err(ExtractError::Source)?
-        {
+        // A spinning sensor's points without their ring cannot be cut into scanlines. A
+        // first batch out of time order is left to the sorted pass below, unchecked.
+        let head = match campaign.next_batch(STREAM_BATCH_POINTS) {
+            Err(SourceError::OutOfOrder { .. }) => None,
+            other => other.map_err(ExtractError::Source)?,
+        };
+        if let Some(b) = head {
             if ring_stage::looks_spinning(&b, &traj) {
                 return Err(ExtractError::Stream {
                     path: first,
