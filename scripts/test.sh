@@ -24,6 +24,26 @@ if [ ${#need_apt[@]} -gt 0 ]; then
   apt-get install -y -qq "${need_apt[@]}" >/dev/null
 fi
 
+# --- the Python test environment, installed in the background ---------------------------
+# A fresh venv with the pinned test dependencies from PyPI (python/requirements-test.txt):
+# mostly download and unpacking, so it runs beside the compile-bound steps below and the
+# Python step only waits for it.
+# The machine's CPython on PATH (3.11 with pip) has venv and ensurepip; Debian's
+# /usr/bin/python3 has them only with python3-venv, so it is the fallback.
+PY=python3
+if ! "$PY" -c 'import venv, ensurepip' >/dev/null 2>&1; then
+  export DEBIAN_FRONTEND=noninteractive
+  /usr/bin/python3 -c 'import venv, ensurepip' >/dev/null 2>&1 ||
+    { apt-get update -qq && apt-get install -y -qq python3-venv >/dev/null; }
+  PY=/usr/bin/python3
+fi
+PY_WORK=$(mktemp -d)
+( "$PY" -m venv "$PY_WORK/venv" &&
+  "$PY_WORK/venv/bin/pip" install -q --disable-pip-version-check -r python/requirements-test.txt
+) >"$PY_WORK/install.log" 2>&1 &
+PY_ENV_PID=$!
+trap 'kill "$PY_ENV_PID" 2>/dev/null || true' EXIT
+
 # --- host -------------------------------------------------------------------------------
 # The host's release builds here go without debug info (the release profile keeps it for
 # profiling): less to compile and link. The firmware keeps its own profile.
@@ -108,18 +128,9 @@ CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$ROOT/target}" \
   cargo clippy --release --manifest-path python/Cargo.toml --all-targets -- -D warnings
 
 step "python: the curbtrace wheel built with maturin into a fresh venv, installed with its pinned test dependencies from PyPI, pytest"
-# The machine's CPython on PATH (3.11 with pip) has venv and ensurepip; Debian's
-# /usr/bin/python3 has them only with python3-venv, so it is the fallback.
-PY=python3
-if ! "$PY" -c 'import venv, ensurepip' >/dev/null 2>&1; then
-  export DEBIAN_FRONTEND=noninteractive
-  /usr/bin/python3 -c 'import venv, ensurepip' >/dev/null 2>&1 ||
-    { apt-get update -qq && apt-get install -y -qq python3-venv >/dev/null; }
-  PY=/usr/bin/python3
+if ! wait "$PY_ENV_PID"; then
+  echo "python: the test environment's install failed (log below)"; cat "$PY_WORK/install.log"; exit 1
 fi
-PY_WORK=$(mktemp -d)
-"$PY" -m venv "$PY_WORK/venv"
-"$PY_WORK/venv/bin/pip" install -q --disable-pip-version-check -r python/requirements-test.txt
 # The release build of the workspace is reused: only pyo3 and the module itself compile.
 CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$ROOT/target}" \
   "$PY_WORK/venv/bin/maturin" build --release --quiet -m python/Cargo.toml \
