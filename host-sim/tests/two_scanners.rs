@@ -56,8 +56,10 @@ fn two_scanners_fused_cover_what_either_covers_once() {
     let mut spec = curbtrace_host_sim::simulate::scene_by_name("kawasaki").unwrap();
     spec.drive = (56.0, 80.0);
     let s = curbtrace_host_sim::simulate::dual::run_two(&spec, 5, None, dir.path(), false).unwrap();
-    let mut cfg = Config::default();
-    cfg.scanners = Mounts::read(&dir.path().join("mounts.toml")).unwrap();
+    let cfg = Config {
+        scanners: Mounts::read(&dir.path().join("mounts.toml")).unwrap(),
+        ..Config::default()
+    };
     assert_eq!(cfg.scanners.get(1).yaw_deg, -cfg.scanners.get(0).yaw_deg);
     let (reference, _) = read_geojson(&s.reference_path).unwrap();
     let run = |scanner: Option<u16>| {
@@ -66,7 +68,7 @@ fn two_scanners_fused_cover_what_either_covers_once() {
             ..ExtractOptions::default()
         };
         stream::extract(
-            &[s.points_path.clone()],
+            std::slice::from_ref(&s.points_path),
             &s.trajectory_path,
             &cfg,
             &opts,
