@@ -6,6 +6,7 @@
 //! [kernel]      # the core's parameters, sent to it in the stream's config packet
 //! [replay]      # line starts and parallel chunks
 //! [bend]        # seeding, tracking, post-filters (Honma et al. §2.6–2.7)
+//! [scanners.N]  # the mount of scanner N (lever arm, roll/pitch/yaw; docs/frames.md)
 //! ```
 //!
 //! A method adds its own table by adding a field with `#[serde(default)]` here (e.g.
@@ -60,6 +61,10 @@ pub struct Config {
     pub bend: BendParams,
     /// The plane-based method (`[qiu]`).
     pub qiu: crate::qiu::QiuParams,
+    /// Where each scanner sits on the vehicle (`[scanners.N]`, see `mounts`); without a
+    /// table a scanner's mount is zero.
+    #[serde(skip_serializing_if = "crate::mounts::Mounts::is_empty")]
+    pub scanners: crate::mounts::Mounts,
 }
 
 impl Config {
@@ -78,6 +83,10 @@ impl Config {
                 .join(" "),
         })?;
         cfg.kernel_words().map_err(|what| ConfigError::Kernel {
+            path: path.to_path_buf(),
+            what,
+        })?;
+        cfg.scanners.check().map_err(|what| ConfigError::Parse {
             path: path.to_path_buf(),
             what,
         })?;

@@ -12,6 +12,7 @@
 //! |---|---|
 //! | [`model`] | shared types: sides, categories, polylines, edges; reading GeoJSON lines |
 //! | `io` | LAS/LAZ reading (columns), trajectory CSV, lidar frames (KITTI, nuScenes, PCD) |
+//! | `mounts` | where each scanner sits on the vehicle: lever arm and angles, the scanner origin's trajectory |
 //! | `replay` | projection (step a), wire encoding, running the core in-process; candidates and per-point status |
 //! | `rings` | spinning lidars: rings cut into half-arcs as scanlines, per-sensor kernel defaults |
 //! | `frame` | curbs in one lidar frame: half-arcs through the core, step check, linking, output |
@@ -31,6 +32,7 @@ pub mod eval;
 pub mod frame;
 pub mod io;
 pub mod model;
+pub mod mounts;
 pub mod output;
 pub mod pipeline;
 pub mod plot;

@@ -158,6 +158,9 @@ pub struct CurbDetail {
     pub bridged: bool,
     /// Observed candidates (one per scanline crossing the toe) per metre of the stretch.
     pub support_per_m: f64,
+    /// The scanner (channel key) whose tracker placed each vertex, where the edges of
+    /// several scanners were fused (`stream::fuse`); empty otherwise.
+    pub scanner: Vec<u16>,
 }
 
 /// Shortest run of bridged toe vertices that makes a stretch of its own, metres; shorter
@@ -175,6 +178,7 @@ impl CurbDetail {
             class: vec![Category::Curb; toe.len()],
             bridged: false,
             support_per_m: 0.0,
+            scanner: Vec::new(),
         }
     }
 
@@ -188,6 +192,11 @@ impl CurbDetail {
             class: self.class[a..b].to_vec(),
             bridged: self.bridged,
             support_per_m: self.support_per_m,
+            scanner: self
+                .scanner
+                .get(a..b)
+                .map(<[u16]>::to_vec)
+                .unwrap_or_default(),
         }
     }
 
@@ -198,6 +207,20 @@ impl CurbDetail {
         self.measured.extend_from_slice(&other.measured);
         self.top_measured.extend_from_slice(&other.top_measured);
         self.class.extend_from_slice(&other.class);
+        // Per-vertex scanners only where both sides have them.
+        if !self.scanner.is_empty() && !other.scanner.is_empty() {
+            self.scanner.extend_from_slice(&other.scanner);
+        } else {
+            self.scanner.clear();
+        }
+    }
+
+    /// The scanners that placed any vertex, ascending (empty where not fused).
+    pub fn scanners(&self) -> Vec<u16> {
+        let mut s = self.scanner.clone();
+        s.sort_unstable();
+        s.dedup();
+        s
     }
 }
 
@@ -405,6 +428,7 @@ pub fn parse_geojson(name: &str, text: &str) -> Result<(Vec<EdgeLine>, Option<Cr
                             .get("support_per_m")
                             .and_then(|s| s.as_f64())
                             .unwrap_or(0.0),
+                        scanner: Vec::new(),
                     })
                 });
             toe_edge.push(edge);

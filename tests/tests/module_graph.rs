@@ -360,6 +360,7 @@ fn the_host_has_no_cycle_and_imports_downwards() {
             ("source", 1),
             ("replay", 2),
             ("rings", 2),
+            ("mounts", 2),
             ("bend", 3),
             ("frame", 3),
             ("qiu", 3),

@@ -65,8 +65,14 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "bend")]
     pub method: MethodArg,
     /// Scanner: LAS 1.4 scanner channel (when the file uses channels) or point source id.
+    /// Without it every scanner is read, each through its own core and tracker, and their
+    /// edges fused.
     #[arg(long)]
     pub scanner: Option<u16>,
+    /// TOML file with the scanners' mounts (a `[scanners]` table, as `simulate --scanners 2`
+    /// writes in `mounts.toml`); replaces the config's `[scanners]`.
+    #[arg(long)]
+    pub mounts: Option<PathBuf>,
     /// TOML file with parameters (see --print-config).
     #[arg(long)]
     pub config: Option<PathBuf>,
@@ -95,10 +101,13 @@ pub struct Args {
 
 /// Runs `curbtrace extract`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let cfg = match &args.config {
+    let mut cfg = match &args.config {
         Some(p) => Config::read(p)?,
         None => Config::default(),
     };
+    if let Some(p) = &args.mounts {
+        cfg.scanners = curbtrace_host_sim::mounts::Mounts::read(p).map_err(anyhow::Error::msg)?;
+    }
     if args.print_config {
         print!(
             "{}",

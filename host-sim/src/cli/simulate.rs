@@ -35,6 +35,10 @@ pub struct Args {
     /// Seconds of driving from the scene's start (default: the scene's whole drive).
     #[arg(long)]
     pub duration: Option<f64>,
+    /// Profilers on the vehicle: 1, or 2 in an X (the second mirrored, with a lever arm;
+    /// channels 0 and 1 in one file, `mounts.toml` and a reference per scanner beside it).
+    #[arg(long, default_value_t = 1, conflicts_with = "sensor")]
+    pub scanners: u8,
 }
 
 /// Runs `curbtrace simulate`.
@@ -68,8 +72,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         println!("{}", spec.description);
     }
     let progress = std::io::stderr().is_terminal();
-    let s = simulate::run_with(&spec, args.seed, args.speed, spin, &args.out, progress)
-        .with_context(|| format!("simulating scene {}", args.scene))?;
+    let s = match args.scanners {
+        1 => simulate::run_with(&spec, args.seed, args.speed, spin, &args.out, progress),
+        2 => simulate::dual::run_two(&spec, args.seed, args.speed, &args.out, progress),
+        n => anyhow::bail!("--scanners {n}: 1 or 2"),
+    }
+    .with_context(|| format!("simulating scene {}", args.scene))?;
     let [curb, cut, inter, bay] = s.reference_m;
     println!(
         "{}{}: {} points, {} lines, {:.1} m driven in {:.1} s, reference {:.1} m (curb {:.1}, curb_cut {:.1}, intersection {:.1}, bus_bay {:.1}); {:.1} s wall ({:.1} s simulating, {:.1} s writing)",

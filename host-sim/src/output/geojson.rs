@@ -34,6 +34,11 @@ pub fn lines_to_geojson(lines: &[EdgeLine], crs: Option<&Crs>) -> serde_json::Va
                         json!(round_to(d.support_per_m, 1e-2)),
                     );
                 }
+                // Fused edges name the scanners that contributed.
+                let scanners = d.scanners();
+                if !scanners.is_empty() {
+                    props.insert("scanners".into(), json!(scanners));
+                }
                 if f.kind == LineKind::Toe {
                     let hs: Vec<f64> = d.height_m.iter().map(|&h| round_to(h, 1e-4)).collect();
                     props.insert("heights_m".into(), json!(hs));

@@ -10,6 +10,7 @@
 //! | [`world`] | building the world: ground, walls, poles, parked cars, weeds, leaves |
 //! | [`ground`] | road, curbs (batter, rounded top), curb cuts, sidewalks as an exact height field |
 //! | [`prims`] | walls, fences, parked cars, poles, weeds, leaves, and the ray walk through them |
+//! | [`dual`] | two profilers in an X (`--scanners 2`): the mirrored second scanner, interleaved returns, a reference per scanner |
 //! | [`drive`] | the vehicle's path, speed and attitude → the 200 Hz trajectory |
 //! | [`scanner`] | the VQ-250-like profiler: pulse directions and timing, noise, intensity |
 //! | [`spinning`] | spinning multi-beam lidars (VLP-16, HDL-32E, HDL-64E, OS1-64) on the roof |
@@ -42,6 +43,7 @@
 
 pub mod centerline;
 pub mod drive;
+pub mod dual;
 pub mod ground;
 pub mod prims;
 pub mod reference;

@@ -75,6 +75,19 @@ pub fn write_points_with(
     epsg: u32,
     ring_name: Option<&str>,
 ) -> Result<(), SimError> {
+    write_points_channels(path, returns, None, origin, epsg, ring_name)
+}
+
+/// [`write_points_with`], with return `i`'s scanner channel `channels[i]` (and point
+/// source id `channels[i] + 1`) when given; channel 0 and point source id 1 otherwise.
+pub fn write_points_channels(
+    path: &Path,
+    returns: &[Return],
+    channels: Option<&[u8]>,
+    origin: [f64; 3],
+    epsg: u32,
+    ring_name: Option<&str>,
+) -> Result<(), SimError> {
     let err = |e: las::Error| SimError::Write {
         path: path.display().to_string(),
         what: e.to_string(),
@@ -110,16 +123,17 @@ pub fn write_points_with(
     let mut w = las::Writer::from_path(path, header).map_err(err)?;
     let wheader = w.header().clone();
     let builder = || las::PointDataBuilder::new().for_header(&wheader);
-    let to_point = |r: &Return| las::Point {
+    let channel = |i: usize| channels.and_then(|c| c.get(i)).copied().unwrap_or(0);
+    let to_point = |(i, r): (usize, &Return)| las::Point {
         x: r.p[0] + origin[0],
         y: r.p[1] + origin[1],
         z: r.p[2] + origin[2],
         intensity: r.intensity,
         return_number: 1,
         number_of_returns: 1,
-        scanner_channel: 0,
+        scanner_channel: channel(i),
         scan_angle: scan_angle_for_las(r.scan_angle_deg),
-        point_source_id: 1,
+        point_source_id: u16::from(channel(i)) + 1,
         gps_time: Some(r.t),
         extra_bytes: if ring_name.is_some() {
             r.ring.to_le_bytes().to_vec()
@@ -129,9 +143,14 @@ pub fn write_points_with(
         ..Default::default()
     };
     // Slabs of a million points: the LAZ writer compresses a slab's chunks in parallel.
-    for chunk in returns.chunks(1 << 20) {
+    for (k, chunk) in returns.chunks(1 << 20).enumerate() {
         let pd = builder()
-            .build_from_points(chunk.iter().map(to_point))
+            .build_from_points(
+                (0..chunk.len())
+                    .map(|i| (k << 20) + i)
+                    .zip(chunk)
+                    .map(to_point),
+            )
             .map_err(err)?;
         w.write_points(&pd).map_err(err)?;
     }

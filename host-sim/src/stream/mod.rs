@@ -17,9 +17,11 @@
 //!   every half revolution of a ring a scanline).
 //! - [`window`] — sections along the route, the bend method per window.
 //! - [`merge`] — joining pieces at section boundaries.
+//! - [`fuse`] — the edges of several scanners (channels) made one edge per curb.
 //! - [`tasks`] — the campaign cut into independent tasks of whole sections, merged after.
 
 pub mod core_stage;
+pub mod fuse;
 pub mod malloc;
 pub mod merge;
 pub mod ring_stage;
@@ -62,6 +64,11 @@ struct Pass {
 
 /// Extracts road edges with the bend method from one or many LAS/LAZ files (files,
 /// directories or glob patterns) and their trajectory, streaming in bounded memory.
+///
+/// The trajectory is the vehicle's reference point; each scanner's origin is it moved by
+/// the scanner's mount (`[scanners]` in `cfg`, zero where none is given). Points of several
+/// scanners (LAS 1.4 scanner channels) without `opts.scanner` are extracted scanner by
+/// scanner, each through a core and a tracker of its own, and fused ([`fuse`]).
 pub fn extract(
     inputs: &[PathBuf],
     traj_path: &Path,
@@ -73,6 +80,64 @@ pub fn extract(
     if opts.method != Method::Bend {
         return Err(ExtractError::Method(opts.method.as_str().into()));
     }
+    let traj = Trajectory::read_csv(traj_path)?;
+    let origin = cfg.scanners.get(opts.scanner.unwrap_or(0)).apply(&traj);
+    let mut result = match extract_channel(inputs, &origin, traj_path, cfg, opts, window, progress)
+    {
+        Err(ExtractError::Source(SourceError::Las(
+            crate::io::las_in::LasError::SeveralScanners { channels, .. },
+        ))) if opts.scanner.is_none() => {
+            let mut per = Vec::with_capacity(channels.len());
+            let mut all: Option<ExtractResult> = None;
+            for c in channels {
+                let key = u16::from(c);
+                let one = ExtractOptions {
+                    scanner: Some(key),
+                    ..*opts
+                };
+                let origin = cfg.scanners.get(key).apply(&traj);
+                let r = extract_channel(inputs, &origin, traj_path, cfg, &one, window, progress)?;
+                per.push((key, r.edges.clone()));
+                all = Some(match all {
+                    None => r,
+                    Some(a) => fuse::add_summaries(a, &r),
+                });
+            }
+            let mut r = all.ok_or_else(|| ExtractError::Stream {
+                path: inputs.first().cloned().unwrap_or_default(),
+                what: "no scanner channel to read".into(),
+            })?;
+            let params = fuse::FuseParams {
+                min_length_m: cfg.bend.min_edge_length_m,
+                ..fuse::FuseParams::default()
+            };
+            r.edges = fuse::fuse(per, &params);
+            r
+        }
+        other => other?,
+    };
+    // The closed edges, cut into stretches of one class and one kind of support.
+    result.edges = crate::curb::finish(std::mem::take(&mut result.edges));
+    for e in &mut result.edges {
+        e.method
+            .get_or_insert_with(|| Method::Bend.as_str().to_string());
+    }
+    result.summary.edges = result.edges.len() as u64;
+    result.summary.total_length_m = result.edges.iter().map(|e| e.length_m()).sum();
+    Ok(result)
+}
+
+/// [`extract`] of one channel (or of every point, one scanner) with the scanner origin's
+/// trajectory `traj`: the closed edges before they are cut into stretches.
+fn extract_channel(
+    inputs: &[PathBuf],
+    traj: &Trajectory,
+    traj_path: &Path,
+    cfg: &Config,
+    opts: &ExtractOptions,
+    window: &WindowParams,
+    progress: &Progress,
+) -> Result<ExtractResult, ExtractError> {
     // laz-rs decompresses on rayon's global pool, which nothing else in the stream uses:
     // its threads are named for the reader when the process has not built it yet.
     let _ = rayon::ThreadPoolBuilder::new()
@@ -80,7 +145,6 @@ pub fn extract(
         .build_global();
     let start = Instant::now();
     let cpu0 = process_cpu_s();
-    let traj = Trajectory::read_csv(traj_path)?;
     let words = cfg.kernel_words().map_err(|what| ConfigError::Kernel {
         path: PathBuf::from("(config)"),
         what,
@@ -99,7 +163,7 @@ pub fn extract(
             other => other.map_err(ExtractError::Source)?,
         };
         if let Some(b) = head {
-            if ring_stage::looks_spinning(&b, &traj) {
+            if ring_stage::looks_spinning(&b, traj) {
                 return Err(ExtractError::Stream {
                     path: first,
                     what: format!(
@@ -131,9 +195,7 @@ pub fn extract(
             Some(runs) => SourceSpec::Sorted(runs, info.clone()),
             None => SourceSpec::Files(inputs.to_vec(), read),
         };
-        match run_pass(
-            spec, &traj, &words, cfg, window, progress, info.bytes, rings,
-        ) {
+        match run_pass(spec, traj, &words, cfg, window, progress, info.bytes, rings) {
             Ok((pass, sel)) => break (pass, sel),
             Err(PassError::Source(SourceError::OutOfOrder { .. })) if !reordered => {
                 // Start again on the sorted runs.
@@ -151,7 +213,7 @@ pub fn extract(
             }
         }
     };
-    let (mut pass, selection) = pass;
+    let (pass, selection) = pass;
     let read = pass.points + pass.dropped.0 + pass.dropped.1;
     if pass.points == 0 || (pass.points as f64) < MIN_COVERED_FRACTION * read as f64 {
         let span = pass.time_span.unwrap_or((f64::NAN, f64::NAN));
@@ -162,12 +224,6 @@ pub fn extract(
             pass.points as usize,
             read as usize,
         )));
-    }
-    // The closed edges, cut into stretches of one class and one kind of support.
-    pass.edges = crate::curb::finish(std::mem::take(&mut pass.edges));
-    for e in &mut pass.edges {
-        e.method
-            .get_or_insert_with(|| Method::Bend.as_str().to_string());
     }
     progress.finish();
     let mut times = pass.times;
