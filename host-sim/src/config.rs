@@ -6,6 +6,7 @@
 //! [kernel]      # the core's parameters, sent to it in the stream's config packet
 //! [replay]      # line starts and parallel chunks
 //! [bend]        # seeding, tracking, post-filters (Honma et al. §2.6–2.7)
+//! [rings]       # the half-arc cut of spinning sensors' files (docs/spec.md §2)
 //! ```
 //!
 //! A method adds its own table by adding a field with `#[serde(default)]` here (e.g.
@@ -60,6 +61,9 @@ pub struct Config {
     pub bend: BendParams,
     /// The plane-based method (`[qiu]`).
     pub qiu: crate::qiu::QiuParams,
+    /// The half-arc cut of a spinning sensor's file (`[rings]`; files with a ring
+    /// dimension only).
+    pub rings: crate::rings::ArcParams,
 }
 
 impl Config {
@@ -80,6 +84,10 @@ impl Config {
         cfg.kernel_words().map_err(|what| ConfigError::Kernel {
             path: path.to_path_buf(),
             what,
+        })?;
+        cfg.rings.validate().map_err(|what| ConfigError::Parse {
+            path: path.to_path_buf(),
+            what: format!("[rings]: {what}"),
         })?;
         Ok(cfg)
     }
@@ -126,6 +134,19 @@ mod tests {
             e.contains("c.toml") && e.contains("chunk_pionts") && !e.contains('\n'),
             "{e}"
         );
+    }
+
+    #[test]
+    fn the_rings_table_is_read_and_checked() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("r.toml");
+        std::fs::write(&p, "[rings]\nmax_reach_m = 12.5\n").unwrap();
+        let c = Config::read(&p).unwrap();
+        assert_eq!(c.rings.max_reach_m, 12.5);
+        assert_eq!(c.rings.min_range_m, crate::rings::ArcParams::default().min_range_m);
+        std::fs::write(&p, "[rings]\nmin_range_m = -1.0\n").unwrap();
+        let e = Config::read(&p).unwrap_err().to_string();
+        assert!(e.contains("[rings]") && e.contains("min_range_m"), "{e}");
     }
 
     #[test]
