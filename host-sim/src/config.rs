@@ -143,7 +143,10 @@ mod tests {
         std::fs::write(&p, "[rings]\nmax_reach_m = 12.5\n").unwrap();
         let c = Config::read(&p).unwrap();
         assert_eq!(c.rings.max_reach_m, 12.5);
-        assert_eq!(c.rings.min_range_m, crate::rings::ArcParams::default().min_range_m);
+        assert_eq!(
+            c.rings.min_range_m,
+            crate::rings::ArcParams::default().min_range_m
+        );
         std::fs::write(&p, "[rings]\nmin_range_m = -1.0\n").unwrap();
         let e = Config::read(&p).unwrap_err().to_string();
         assert!(e.contains("[rings]") && e.contains("min_range_m"), "{e}");
