@@ -6,6 +6,7 @@
 //! [kernel]      # the core's parameters, sent to it in the stream's config packet
 //! [replay]      # line starts and parallel chunks
 //! [bend]        # seeding, tracking, post-filters (Honma et al. §2.6–2.7)
+//! [rings]       # the half-arc cut of spinning sensors' files (docs/spec.md §2)
 //! [scanners.N]  # the mount of scanner N (lever arm, roll/pitch/yaw; docs/frames.md)
 //! ```
 //!
@@ -61,6 +62,9 @@ pub struct Config {
     pub bend: BendParams,
     /// The plane-based method (`[qiu]`).
     pub qiu: crate::qiu::QiuParams,
+    /// The half-arc cut of a spinning sensor's file (`[rings]`; files with a ring
+    /// dimension only).
+    pub rings: crate::rings::ArcParams,
     /// Where each scanner sits on the vehicle (`[scanners.N]`, see `mounts`); without a
     /// table a scanner's mount is zero.
     #[serde(skip_serializing_if = "crate::mounts::Mounts::is_empty")]
@@ -85,6 +89,10 @@ impl Config {
         cfg.kernel_words().map_err(|what| ConfigError::Kernel {
             path: path.to_path_buf(),
             what,
+        })?;
+        cfg.rings.validate().map_err(|what| ConfigError::Parse {
+            path: path.to_path_buf(),
+            what: format!("[rings]: {what}"),
         })?;
         cfg.scanners.check().map_err(|what| ConfigError::Parse {
             path: path.to_path_buf(),
@@ -135,6 +143,22 @@ mod tests {
             e.contains("c.toml") && e.contains("chunk_pionts") && !e.contains('\n'),
             "{e}"
         );
+    }
+
+    #[test]
+    fn the_rings_table_is_read_and_checked() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("r.toml");
+        std::fs::write(&p, "[rings]\nmax_reach_m = 12.5\n").unwrap();
+        let c = Config::read(&p).unwrap();
+        assert_eq!(c.rings.max_reach_m, 12.5);
+        assert_eq!(
+            c.rings.min_range_m,
+            crate::rings::ArcParams::default().min_range_m
+        );
+        std::fs::write(&p, "[rings]\nmin_range_m = -1.0\n").unwrap();
+        let e = Config::read(&p).unwrap_err().to_string();
+        assert!(e.contains("[rings]") && e.contains("min_range_m"), "{e}");
     }
 
     #[test]

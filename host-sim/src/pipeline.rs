@@ -187,6 +187,8 @@ pub struct Summary {
     pub dropped_after_trajectory: u64,
     /// Points the stream's window dropped under its time cap (a standing vehicle).
     pub dropped_by_window_cap: u64,
+    /// The half-arc cut's counters, for a spinning sensor's file (`stream::ring_stage`).
+    pub arcs: Option<crate::rings::ArcCounters>,
     /// The core's counters.
     pub core: ReplayCounters,
     /// Seed candidates from the core.
@@ -218,7 +220,7 @@ impl Summary {
         format!(
             "points read        {read} of {file} in {path}\n\
              dropped            {before} before and {after} after the trajectory, {trunc} in over-long lines, {lost} lost in the core, {irr} irregular (§2.4), {nn} without neighbours{cap}\n\
-             scanlines          {lines}\n\
+             scanlines          {lines}{arcs}\n\
              candidates         {cand}\n\
              edges              {edges}, total length {len:.1} m\n\
              time               {total:.2} s ({pts:.2} M points/s): read {r:.2} s, trajectory {t:.2} s, core {k:.2} s, edges {e:.2} s\n\
@@ -242,6 +244,7 @@ impl Summary {
             irr = c.irregular,
             nn = c.no_neighbour,
             lines = c.scanlines,
+            arcs = self.arcs.map(|a| arcs_text(&a)).unwrap_or_default(),
             cand = self.candidates,
             edges = self.edges,
             total = self.times.total_s,
@@ -286,6 +289,21 @@ impl Summary {
             )
         }
     }
+}
+
+/// The half-arc cut's counters after the scanline count: what became scanlines and what
+/// was left out (docs/spec.md §2, *What is left out*).
+fn arcs_text(a: &crate::rings::ArcCounters) -> String {
+    format!(
+        " (half-arcs of {rings} rings; skipped: {short} short, {road} without road at the centre line, {far} beyond the reach; points left out: {near} near, {lat} beyond the side, {piled} piled up)",
+        rings = a.rings,
+        short = a.skipped_short,
+        road = a.skipped_no_road,
+        far = a.skipped_far,
+        near = a.points_near,
+        lat = a.points_lateral,
+        piled = a.points_piled,
+    )
 }
 
 /// The result of [`extract_file`].
@@ -468,6 +486,7 @@ pub fn extract_file_with(
         dropped_before_trajectory: r.dropped.0,
         dropped_after_trajectory: r.dropped.1,
         dropped_by_window_cap: 0,
+        arcs: None,
         core: r.kernel.counters,
         candidates: r.kernel.candidates.len() as u64,
         edges: edges.len() as u64,
@@ -519,6 +538,7 @@ fn extract_qiu(
         dropped_before_trajectory: dropped.0,
         dropped_after_trajectory: dropped.1,
         dropped_by_window_cap: 0,
+        arcs: None,
         core: ReplayCounters::default(),
         candidates: 0,
         edges: edges.len() as u64,

@@ -1,7 +1,8 @@
 //! Spinning multi-beam lidars through `curbtrace extract` (docs/spec.md, *Spinning
 //! sensors*): a few revolutions of each sensor family on the `tiny` street, simulated with
 //! a ring dimension, extracted by the stream and scored against the simulator's reference;
-//! the same points without their ring are refused with a message that says so.
+//! the same points without their ring are refused with a message that says so, in time
+//! order or not.
 //!
 //! CI-sized: 0.4 s of driving (five revolutions) per sensor, a few seconds in all. The
 //! floors are far below the 10 s drives of docs/results.md: five revolutions see each curb
@@ -25,10 +26,18 @@ fn simulate(sensor: &SpinSensor, ring_name: Option<&str>, dir: &Path) {
 }
 
 fn extract(dir: &Path) -> anyhow::Result<curbtrace_host_sim::pipeline::ExtractResult> {
+    extract_with(&dir.join("points.laz"), dir, &Config::default())
+}
+
+fn extract_with(
+    points: &Path,
+    dir: &Path,
+    cfg: &Config,
+) -> anyhow::Result<curbtrace_host_sim::pipeline::ExtractResult> {
     Ok(stream::extract(
-        &[dir.join("points.laz")],
+        &[points.to_path_buf()],
         &dir.join("trajectory.csv"),
-        &Config::default(),
+        cfg,
         &ExtractOptions::default(),
         &WindowParams::default(),
         &Progress::hidden(),
@@ -88,12 +97,61 @@ fn every_ring_name_is_read_and_a_file_without_one_is_refused() {
         "{:?}",
         with_ring.summary.core
     );
-    simulate(&sensor, None, dir.path());
-    let err = extract(dir.path())
-        .expect_err("no ring: refused")
-        .to_string();
+    // Every half-arc kept is one scanline, and the summary says so.
+    let arcs = with_ring
+        .summary
+        .arcs
+        .expect("a ring file's summary counts half-arcs");
+    assert_eq!(u64::from(arcs.arcs), with_ring.summary.core.scanlines);
+    assert_eq!(arcs.rings, 16, "{arcs:?}");
+    assert!(with_ring
+        .summary
+        .to_text()
+        .contains("half-arcs of 16 rings"));
+    // `[rings]` from the config applies: a shorter reach skips more arcs as too far.
+    let mut near_only = Config::default();
+    near_only.rings.max_reach_m = 8.0;
+    let short = extract_with(&dir.path().join("points.laz"), dir.path(), &near_only)
+        .expect("extraction runs");
+    let short_arcs = short.summary.arcs.expect("counted");
     assert!(
-        err.contains("spinning") && err.contains("no ring") && !err.contains('\n'),
-        "{err}"
+        short_arcs.skipped_far > arcs.skipped_far && short_arcs.arcs < arcs.arcs,
+        "{short_arcs:?} against {arcs:?}"
     );
+    simulate(&sensor, None, dir.path());
+    let refused = |points: &Path| {
+        let err = extract_with(points, dir.path(), &Config::default())
+            .expect_err("no ring: refused")
+            .to_string();
+        assert!(
+            err.contains("spinning") && err.contains("no ring") && !err.contains('\n'),
+            "{err}"
+        );
+    };
+    refused(&dir.path().join("points.laz"));
+    // The same points in reverse time order: the first batch is out of order and is
+    // checked all the same.
+    let reversed = dir.path().join("reversed.las");
+    write_reversed(&dir.path().join("points.laz"), &reversed);
+    refused(&reversed);
+}
+
+/// `src`'s points written to `dst` (uncompressed) in reverse order.
+fn write_reversed(src: &Path, dst: &Path) {
+    let mut reader = las::Reader::from_path(src).expect("points read");
+    let mut header = las::Builder::from(reader.header().clone());
+    header.point_format.is_compressed = false;
+    let header = header.into_header().expect("header");
+    let mut points: Vec<las::Point> = reader
+        .read_all()
+        .expect("points read")
+        .points()
+        .map(|p| p.expect("point"))
+        .collect();
+    points.reverse();
+    let mut w = las::Writer::from_path(dst, header).expect("writer");
+    for p in points {
+        w.write_point(p).expect("point written");
+    }
+    w.close().expect("closed");
 }

@@ -106,6 +106,24 @@ impl Default for ArcParams {
     }
 }
 
+impl ArcParams {
+    /// Every distance finite and not negative; on failure, which field and its value.
+    pub fn validate(&self) -> Result<(), String> {
+        for (name, v) in [
+            ("min_range_m", self.min_range_m),
+            ("max_lateral_m", self.max_lateral_m),
+            ("max_reach_m", self.max_reach_m),
+            ("min_depth_m", self.min_depth_m),
+            ("min_separation_m", self.min_separation_m),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("{name} = {v}: must be a finite distance ≥ 0"));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// One half of one ring, as a scanline.
 #[derive(Clone, Debug, PartialEq)]
 pub struct HalfArc {

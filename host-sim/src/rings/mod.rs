@@ -6,8 +6,10 @@
 //! - [`sensor`] — per-sensor facts (rings, rate, azimuth step) and the kernel parameters
 //!   set from them.
 //! - [`arc`] — ring assembly, the half-arc cut with its pseudo-nadir, and the projection.
+//! - [`run`] — half-arcs through the core, one line each.
 
 pub mod arc;
+pub mod run;
 pub mod sensor;
 
 pub use arc::{half_arcs, project, ArcCounters, ArcParams, Half, HalfArc};

@@ -53,49 +53,32 @@ pub struct CoreBatch {
     pub candidates: Vec<Candidate>,
 }
 
-/// The core stage's state between batches.
-pub struct CoreStage<'a> {
-    traj: &'a Trajectory,
-    words: [u32; CONFIG_WORDS],
-    params: ReplayParams,
+/// What both core stages (this one and `ring_stage`'s) count as batches come in: the
+/// span of times read, and the points outside the trajectory's time range, dropped.
+#[derive(Clone, Copy, Debug)]
+pub struct Intake {
     t_range: (f64, f64),
-    rule: Option<LineRule>,
-    carry: PointBatch,
-    next_base: u64,
-    lines: u32,
-    /// Counters summed over the stream.
-    pub counters: ReplayCounters,
     /// Points before / after the trajectory.
     pub dropped: (u64, u64),
-    /// Points kept.
-    pub points: u64,
     /// Times of the first and the last point read, before the trajectory's cut.
     pub time_span: Option<(f64, f64)>,
 }
 
-impl<'a> CoreStage<'a> {
-    /// A stage for `traj` with the core's config `words`.
-    pub fn new(traj: &'a Trajectory, words: [u32; CONFIG_WORDS], params: ReplayParams) -> Self {
+impl Intake {
+    /// Counting against `traj`'s time range.
+    pub fn new(traj: &Trajectory) -> Self {
         Self {
-            traj,
-            words,
-            params,
             t_range: traj
                 .time_range()
                 .unwrap_or((f64::INFINITY, f64::NEG_INFINITY)),
-            rule: None,
-            carry: PointBatch::default(),
-            next_base: 0,
-            lines: 0,
-            counters: ReplayCounters::default(),
             dropped: (0, 0),
-            points: 0,
             time_span: None,
         }
     }
 
-    /// Takes a batch; returns the core's output for the whole lines it completes.
-    pub fn push(&mut self, b: PointBatch) -> Result<Option<CoreBatch>, CoreError> {
+    /// Counts `b` (in time order) and returns the range of its points within the
+    /// trajectory's time range.
+    pub fn admit(&mut self, b: &PointBatch) -> std::ops::Range<usize> {
         if let (Some(&first), Some(&last)) = (b.t.first(), b.t.last()) {
             let (a, z) = self.time_span.get_or_insert((first, last));
             *a = a.min(first);
@@ -106,10 +89,51 @@ impl<'a> CoreStage<'a> {
         let hi = b.t.partition_point(|&t| t <= t1).max(lo);
         self.dropped.0 += lo as u64;
         self.dropped.1 += (b.len() - hi) as u64;
-        if self.carry.is_empty() && lo == 0 && hi == b.len() {
+        lo..hi
+    }
+}
+
+/// The core stage's state between batches.
+pub struct CoreStage<'a> {
+    traj: &'a Trajectory,
+    words: [u32; CONFIG_WORDS],
+    params: ReplayParams,
+    rule: Option<LineRule>,
+    carry: PointBatch,
+    next_base: u64,
+    lines: u32,
+    /// Counters summed over the stream.
+    pub counters: ReplayCounters,
+    /// Points dropped outside the trajectory, times read.
+    pub intake: Intake,
+    /// Points kept.
+    pub points: u64,
+}
+
+impl<'a> CoreStage<'a> {
+    /// A stage for `traj` with the core's config `words`.
+    pub fn new(traj: &'a Trajectory, words: [u32; CONFIG_WORDS], params: ReplayParams) -> Self {
+        Self {
+            traj,
+            words,
+            params,
+            rule: None,
+            carry: PointBatch::default(),
+            next_base: 0,
+            lines: 0,
+            counters: ReplayCounters::default(),
+            intake: Intake::new(traj),
+            points: 0,
+        }
+    }
+
+    /// Takes a batch; returns the core's output for the whole lines it completes.
+    pub fn push(&mut self, b: PointBatch) -> Result<Option<CoreBatch>, CoreError> {
+        let kept = self.intake.admit(&b);
+        if self.carry.is_empty() && kept == (0..b.len()) {
             self.carry = b;
         } else {
-            self.carry.extend_from(&b, lo..hi);
+            self.carry.extend_from(&b, kept);
         }
         if self.carry.is_empty() {
             return Ok(None);

@@ -54,6 +54,7 @@ pub const STREAM_BATCH_POINTS: usize = BATCH_POINTS;
 struct Pass {
     edges: Vec<EdgeLine>,
     counters: ReplayCounters,
+    arcs: Option<crate::rings::ArcCounters>,
     dropped: (u64, u64),
     points: u64,
     time_span: Option<(f64, f64)>,
@@ -157,9 +158,12 @@ fn extract_channel(
     let first = info.files.first().cloned().unwrap_or_default();
     if info.ring.is_none() {
         // A spinning sensor's points without their ring cannot be cut into scanlines. A
-        // first batch out of time order is left to the sorted pass below, unchecked.
+        // first batch out of time order is read again without the order check (the check
+        // puts it in time order itself).
         let head = match campaign.next_batch(STREAM_BATCH_POINTS) {
-            Err(SourceError::OutOfOrder { .. }) => None,
+            Err(SourceError::OutOfOrder { .. }) => Campaign::open(inputs, &read)
+                .and_then(|c| c.unchecked().next_batch(STREAM_BATCH_POINTS))
+                .map_err(ExtractError::Source)?,
             other => other.map_err(ExtractError::Source)?,
         };
         if let Some(b) = head {
@@ -181,7 +185,7 @@ fn extract_channel(
     let window = &WindowParams {
         margin_m: window.margin_m
             + if rings {
-                f64::from(crate::rings::ArcParams::default().max_reach_m)
+                f64::from(cfg.rings.max_reach_m)
             } else {
                 0.0
             },
@@ -236,6 +240,7 @@ fn extract_channel(
         dropped_before_trajectory: pass.dropped.0,
         dropped_after_trajectory: pass.dropped.1,
         dropped_by_window_cap: pass.capped_points,
+        arcs: pass.arcs,
         core: pass.counters,
         candidates: pass.candidates,
         edges: pass.edges.len() as u64,
@@ -250,8 +255,14 @@ fn extract_channel(
 }
 
 /// What a core stage counted: its counters, points dropped before / after the trajectory,
-/// points kept, the time span read.
-type StageTotals = (ReplayCounters, (u64, u64), u64, Option<(f64, f64)>);
+/// points kept, the time span read, the half-arc cut's counters (rings only).
+type StageTotals = (
+    ReplayCounters,
+    (u64, u64),
+    u64,
+    Option<(f64, f64)>,
+    Option<crate::rings::ArcCounters>,
+);
 
 /// The core stage: scanlines of a profiler, or rings of a spinning sensor.
 enum Stage<'a> {
@@ -277,11 +288,24 @@ impl Stage<'_> {
         }
     }
 
-    /// Counters, points dropped before / after the trajectory, points kept, time span.
+    /// Counters, points dropped before / after the trajectory, points kept, time span,
+    /// the half-arc cut's counters.
     fn totals(&self) -> StageTotals {
         match self {
-            Stage::Lines(s) => (s.counters, s.dropped, s.points, s.time_span),
-            Stage::Rings(s) => (s.counters, s.dropped, s.points, s.time_span),
+            Stage::Lines(s) => (
+                s.counters,
+                s.intake.dropped,
+                s.points,
+                s.intake.time_span,
+                None,
+            ),
+            Stage::Rings(s) => (
+                s.counters,
+                s.intake.dropped,
+                s.points,
+                s.intake.time_span,
+                Some(s.arc_counters()),
+            ),
         }
     }
 }
@@ -373,11 +397,7 @@ fn run_pass(
             .name("ct-core".into())
             .spawn_scoped(s, move || {
                 let mut stage = if rings {
-                    Stage::Rings(Box::new(ring_stage::RingStage::new(
-                        traj,
-                        crate::rings::ArcParams::default(),
-                        None,
-                    )))
+                    Stage::Rings(Box::new(ring_stage::RingStage::new(traj, cfg.rings, None)))
                 } else {
                     Stage::Lines(Box::new(core_stage::CoreStage::new(
                         traj, *words, cfg.replay,
@@ -454,7 +474,7 @@ fn run_pass(
         if let Some(e) = err {
             return Err(e);
         }
-        let Some((counters, dropped, points, time_span)) = core_out else {
+        let Some((counters, dropped, points, time_span, arcs)) = core_out else {
             return Err(PassError::Core(core_stage::CoreError::Replay(
                 crate::replay::run::ReplayError::Stalled,
             )));
@@ -483,6 +503,7 @@ fn run_pass(
             Pass {
                 edges,
                 counters,
+                arcs,
                 dropped,
                 points,
                 time_span,

@@ -21,23 +21,16 @@
 //!
 //! A batch is cut before the earliest run still open, so no arc is split between batches.
 
-use super::core_stage::{CoreBatch, CoreError};
+use super::core_stage::{CoreBatch, CoreError, Intake};
 use crate::io::trajectory::Trajectory;
 use crate::model::Side;
 use crate::replay::project::PoseCursor;
 use crate::replay::run::{ReplayCounters, ReplayError};
 use crate::replay::{Candidate, PointStatus};
+use crate::rings::run::{self as arc_run, ArcPipeline, ArcPoint, ArcRunError};
 use crate::rings::{project, ArcCounters, ArcParams, SensorModel};
 use crate::source::PointBatch;
 use curbtrace_core::kernel::{KernelParams, ScanlineOutput};
-use curbtrace_core::wire::{PointRecord, StreamEncoder, MAX_PACKET_LEN, MAX_POINTS_PER_PACKET};
-use curbtrace_core::Pipeline;
-
-/// Longest half-arc the core holds; more points are counted as truncated. A half
-/// revolution of one laser is 512–1 100 points on the sensors of docs/simulator.md.
-pub const ARC_CAPACITY: usize = 4096;
-/// The pipeline the arcs run through.
-type ArcPipeline = Pipeline<{ 1 << 16 }, ARC_CAPACITY>;
 
 /// Points of the first batches the sensor's azimuth step and rate are estimated from.
 const ESTIMATE_POINTS: usize = 20_000;
@@ -69,12 +62,15 @@ fn body_of(cur: &mut PoseCursor<'_>, x: f64, y: f64, z: f64, t: f64) -> Option<B
 /// Whether the points of `b` come from a spinning multi-beam sensor (module constant
 /// [`SPINNING_DEG_PER_S`]): the median angle between the directions of consecutive
 /// returns, seen from the trajectory's origin at their times, per second between them.
+/// The points need not be in time order: they are taken in time order here.
 pub fn looks_spinning(b: &PointBatch, traj: &Trajectory) -> bool {
     let mut cur = PoseCursor::new(traj);
     let n = b.len().min(ESTIMATE_POINTS);
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&i, &j| b.t[i].total_cmp(&b.t[j]));
     let mut speeds = Vec::with_capacity(n);
     let mut prev: Option<([f64; 3], f64)> = None;
-    for i in 0..n {
+    for i in order {
         let Some(p) = body_of(&mut cur, b.x[i], b.y[i], b.z[i], b.t[i]) else {
             prev = None;
             continue;
@@ -161,7 +157,6 @@ pub struct RingStage<'a> {
     arc: ArcParams,
     kernel: Option<KernelParams>,
     sensor: Option<SensorModel>,
-    t_range: (f64, f64),
     carry: PointBatch,
     /// The vehicle-frame coordinates of the first carried points (computed once).
     body: Vec<Body>,
@@ -172,12 +167,12 @@ pub struct RingStage<'a> {
     pub counters: ReplayCounters,
     /// The half-arc cut's counters summed over the stream.
     pub arcs: ArcCounters,
-    /// Points before / after the trajectory.
-    pub dropped: (u64, u64),
+    /// Rings seen, one bit each.
+    rings_seen: [u64; 4],
+    /// Points dropped outside the trajectory, times read.
+    pub intake: Intake,
     /// Points kept.
     pub points: u64,
-    /// Times of the first and the last point read, before the trajectory's cut.
-    pub time_span: Option<(f64, f64)>,
 }
 
 impl<'a> RingStage<'a> {
@@ -188,9 +183,6 @@ impl<'a> RingStage<'a> {
             arc,
             kernel,
             sensor: None,
-            t_range: traj
-                .time_range()
-                .unwrap_or((f64::INFINITY, f64::NEG_INFINITY)),
             carry: PointBatch::default(),
             body: Vec::new(),
             next_base: 0,
@@ -198,9 +190,17 @@ impl<'a> RingStage<'a> {
             pipe: Box::new(ArcPipeline::new()),
             counters: ReplayCounters::default(),
             arcs: ArcCounters::default(),
-            dropped: (0, 0),
+            rings_seen: [0; 4],
+            intake: Intake::new(traj),
             points: 0,
-            time_span: None,
+        }
+    }
+
+    /// The half-arc cut's counters so far, with the rings seen.
+    pub fn arc_counters(&self) -> ArcCounters {
+        ArcCounters {
+            rings: self.rings_seen.iter().map(|w| w.count_ones()).sum(),
+            ..self.arcs
         }
     }
 
@@ -211,17 +211,8 @@ impl<'a> RingStage<'a> {
 
     /// Takes a batch; returns the core's output for the points of the arcs it completes.
     pub fn push(&mut self, b: PointBatch) -> Result<Option<CoreBatch>, CoreError> {
-        if let (Some(&first), Some(&last)) = (b.t.first(), b.t.last()) {
-            let (a, z) = self.time_span.get_or_insert((first, last));
-            *a = a.min(first);
-            *z = z.max(last);
-        }
-        let (t0, t1) = self.t_range;
-        let lo = b.t.partition_point(|&t| t < t0);
-        let hi = b.t.partition_point(|&t| t <= t1).max(lo);
-        self.dropped.0 += lo as u64;
-        self.dropped.1 += (b.len() - hi) as u64;
-        self.carry.extend_from(&b, lo..hi);
+        let kept = self.intake.admit(&b);
+        self.carry.extend_from(&b, kept);
         if self.sensor.is_none() {
             if self.carry.len() < ESTIMATE_POINTS {
                 return Ok(None);
@@ -291,6 +282,7 @@ impl<'a> RingStage<'a> {
                 continue;
             }
             let ring = c.channel[i];
+            self.rings_seen[usize::from(ring >> 6)] |= 1 << (ring & 63);
             let front = p.x >= 0.0;
             let slot = &mut open[usize::from(ring)];
             match slot {
@@ -408,8 +400,8 @@ impl<'a> RingStage<'a> {
         Some(pts)
     }
 
-    /// Runs `arcs` through a fresh pipeline (config packet first, one line per arc) and
-    /// returns the first `cut` carried points with the core's output.
+    /// Runs `arcs` through a fresh pipeline (`rings::run`: config packet first, one line
+    /// per arc) and returns the first `cut` carried points with the core's output.
     fn run_core(
         &mut self,
         body: &[Body],
@@ -424,82 +416,66 @@ impl<'a> RingStage<'a> {
         let mut cands: Vec<Candidate> = Vec::new();
         let base_line = self.lines;
         let mut counters = ReplayCounters::default();
-        {
-            let mut line_no = 0u32;
-            let mut collect = |o: &ScanlineOutput<'_>| {
-                let line = base_line + line_no;
-                line_no += 1;
-                counters.scanlines += 1;
-                counters.truncated += u64::from(o.truncated);
-                for (k, &tag) in o.tag.iter().enumerate() {
-                    let j = tag as usize;
-                    if j >= cut {
-                        continue;
-                    }
-                    rho[j] = o.rho_deg[k];
-                    status[j] = Some(o.status[k]);
-                    scanline[j] = line;
-                    match o.status[k] {
-                        PointStatus::Kept => counters.kept += 1,
-                        PointStatus::Irregular => counters.irregular += 1,
-                        PointStatus::NoNeighbour => counters.no_neighbour += 1,
-                        _ => {}
-                    }
+        let mut line_no = 0u32;
+        let mut collect = |o: &ScanlineOutput<'_>| {
+            let line = base_line + line_no;
+            line_no += 1;
+            counters.scanlines += 1;
+            counters.truncated += u64::from(o.truncated);
+            for (k, &tag) in o.tag.iter().enumerate() {
+                let j = tag as usize;
+                if j >= cut {
+                    continue;
                 }
-                for (side, k) in [(Side::Left, o.left), (Side::Right, o.right)] {
-                    if let Some(&tag) = k.and_then(|k| o.tag.get(usize::from(k))) {
-                        cands.push(Candidate {
-                            point: tag,
-                            side,
-                            scanline: line,
-                        });
-                    }
+                rho[j] = o.rho_deg[k];
+                status[j] = Some(o.status[k]);
+                scanline[j] = line;
+                match o.status[k] {
+                    PointStatus::Kept => counters.kept += 1,
+                    PointStatus::Irregular => counters.irregular += 1,
+                    PointStatus::NoNeighbour => counters.no_neighbour += 1,
+                    _ => {}
                 }
-            };
-            *self.pipe = ArcPipeline::new();
-            let pipe = &mut *self.pipe;
-            let mut enc = StreamEncoder::new();
-            let mut buf = vec![0u8; MAX_PACKET_LEN];
-            let enc_err = |e| CoreError::Replay(ReplayError::Encode(e));
-            let m = enc
-                .encode_config(&kernel.to_words(), &mut buf)
-                .map_err(enc_err)?;
-            feed(pipe, &buf[..m], &mut collect)?;
-            counters.packets += 1;
-            counters.bytes += m as u64;
-            let period_ns = (1e9 / sensor.rate_hz.max(0.1)) as u64;
-            let step_ns =
-                ((sensor.azimuth_step_deg / 360.0) * 1e9 / sensor.rate_hz.max(0.1)).max(1.0) as u32;
-            let mut recs: Vec<PointRecord> = Vec::with_capacity(MAX_POINTS_PER_PACKET);
-            for (a, arc) in arcs.iter().enumerate() {
-                let t_arc = (u64::from(base_line) + a as u64 + 1) * period_ns;
-                for (ci, chunk) in arc.chunks(MAX_POINTS_PER_PACKET).enumerate() {
-                    recs.clear();
-                    let k0 = ci * MAX_POINTS_PER_PACKET;
-                    for (j, &i) in chunk.iter().enumerate() {
-                        let b = body[i as usize];
-                        let (xp, zp) = project(b.x, b.y, b.z);
-                        recs.push(PointRecord {
-                            dt_ns: j as u32 * step_ns,
-                            x_m: xp,
-                            z_m: zp,
-                            intensity: self.carry.intensity[i as usize],
-                            line_start: k0 + j == 0,
-                            tag: i,
-                        });
-                    }
-                    let t0 = t_arc + k0 as u64 * u64::from(step_ns);
-                    let m = enc.encode_points(t0, &recs, &mut buf).map_err(enc_err)?;
-                    feed(pipe, &buf[..m], &mut collect)?;
-                    counters.packets += 1;
-                    counters.bytes += m as u64;
-                    counters.points_sent += chunk.len() as u64;
-                }
-                pipe.run(&mut collect);
             }
-            pipe.finish(&mut collect);
-            self.lines = self.lines.saturating_add(line_no);
-        }
+            for (side, k) in [(Side::Left, o.left), (Side::Right, o.right)] {
+                if let Some(&tag) = k.and_then(|k| o.tag.get(usize::from(k))) {
+                    cands.push(Candidate {
+                        point: tag,
+                        side,
+                        scanline: line,
+                    });
+                }
+            }
+        };
+        let intensity = &self.carry.intensity;
+        let points = arcs.iter().map(|arc| {
+            arc.iter().map(|&i| {
+                let b = body[i as usize];
+                let (x_m, z_m) = project(b.x, b.y, b.z);
+                ArcPoint {
+                    x_m,
+                    z_m,
+                    intensity: intensity[i as usize],
+                    tag: i,
+                }
+            })
+        });
+        let sent = arc_run::run_arcs(
+            &mut self.pipe,
+            kernel,
+            sensor,
+            u64::from(base_line) + 1,
+            points,
+            &mut collect,
+        )
+        .map_err(|e| match e {
+            ArcRunError::Encode(e) => CoreError::Replay(ReplayError::Encode(e)),
+            ArcRunError::Stalled => CoreError::Replay(ReplayError::Stalled),
+        })?;
+        counters.packets += sent.packets;
+        counters.bytes += sent.bytes;
+        counters.points_sent += sent.points;
+        self.lines = self.lines.saturating_add(line_no);
         let rest = {
             let mut r =
                 PointBatch::with_capacity(self.carry.len() - cut + super::STREAM_BATCH_POINTS);
@@ -524,28 +500,6 @@ impl<'a> RingStage<'a> {
             candidates: cands,
         })
     }
-}
-
-/// Writes `b` into the pipeline, processing complete lines whenever the ring is full.
-fn feed(
-    pipe: &mut ArcPipeline,
-    b: &[u8],
-    on_line: &mut impl FnMut(&ScanlineOutput<'_>),
-) -> Result<(), CoreError> {
-    let mut off = 0;
-    while off < b.len() {
-        let w = pipe.write(&b[off..]);
-        off += w;
-        if w == 0 {
-            pipe.run(&mut *on_line);
-            let w2 = pipe.write(&b[off..]);
-            if w2 == 0 {
-                return Err(CoreError::Replay(ReplayError::Stalled));
-            }
-            off += w2;
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]
