@@ -155,7 +155,10 @@ mod tests {
                 let mut dst = vec![0xEEu8; 110];
                 copy_words(&mut dst[d_o..d_o + len], &src[so..so + len]);
                 assert_eq!(&dst[d_o..d_o + len], &src[so..so + len], "len {len}");
-                assert!(dst[..d_o].iter().chain(&dst[d_o + len..]).all(|&b| b == 0xEE));
+                assert!(dst[..d_o]
+                    .iter()
+                    .chain(&dst[d_o + len..])
+                    .all(|&b| b == 0xEE));
             }
         }
     }
