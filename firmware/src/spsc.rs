@@ -152,7 +152,7 @@ mod tests {
         let src: Vec<u8> = (0..200u32).map(|i| (i * 7 + 3) as u8).collect();
         for len in 0..100 {
             for (so, d_o) in [(0, 0), (1, 0), (0, 3), (2, 1), (3, 3)] {
-                let mut dst = vec![0xEEu8; 110];
+                let mut dst = [0xEEu8; 110];
                 copy_words(&mut dst[d_o..d_o + len], &src[so..so + len]);
                 assert_eq!(&dst[d_o..d_o + len], &src[so..so + len], "len {len}");
                 assert!(dst[..d_o]
