@@ -8,7 +8,11 @@
 # the rate in points per second (bytes per point from the stream) for the largest with no
 # dropped byte, checks that run's output against `curbtrace kernel` byte for byte, and
 # prints `name: value` lines, the rate also scaled to 1.5 cycles per instruction (the
-# assumption of docs/benchmarks.md): rate · CPI(shift) / 1.5.
+# assumption of docs/benchmarks.md): rate · CPI(shift) / 1.5. `sleep=off` makes the runs
+# deterministic: while the loop sleeps (`WFI`) the guest's clock jumps to the next tick
+# instead of following the host's clock, so the same rate gives the same bytes dropped and
+# the same queue high water on every run, however busy the host is (with QEMU's default
+# `sleep=on` the high water varied between runs, and bisections disagreed).
 #
 # Needs what firmware/check.sh needs. Environment: SHIFT (default 3), FIRMWARE_TARGET_DIR,
 # CARGO_TARGET_DIR, LO / HI (points/s bracket, default 50000 / 400000), STEPS (default 8).
@@ -44,7 +48,7 @@ bytes=$(stat -c %s "$STREAM")
 run() { # POINTS_PER_S → dropped bytes (output in $WORK/out-RATE.bin)
   local rate=$1 bps
   bps=$(awk -v r="$rate" -v b="$bytes" -v p="$points" 'BEGIN { printf "%d", r * b / p }')
-  timeout 600 qemu-system-arm -machine netduinoplus2 -nographic -icount "shift=$SHIFT" \
+  timeout 600 qemu-system-arm -machine netduinoplus2 -nographic -icount "shift=$SHIFT,sleep=off" \
     -semihosting-config "enable=on,target=native,arg=fw,arg=--realtime=$bps,arg=$STREAM,arg=$WORK/out-$rate.bin" \
     -kernel "$ELF" < /dev/null > "$WORK/rt-$rate.txt" 2>&1 || die "the run at $rate points/s failed: $(cat "$WORK/rt-$rate.txt")"
   awk -F': ' '$1 == "realtime_dropped_bytes" { print $2 }' "$WORK/rt-$rate.txt"

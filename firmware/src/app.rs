@@ -46,7 +46,7 @@ pub const RING: usize = 16 * 1024;
 const _: () = assert!(RING >= DMA_CHUNK + MAX_PACKET_LEN);
 
 /// Bytes moved per transfer into the ring (a DMA half-transfer, a `read()` call).
-pub const DMA_CHUNK: usize = 1024;
+pub const DMA_CHUNK: usize = 4096;
 
 /// The firmware's pipeline: ring, parser, assembly and kernel for its line size.
 pub type Node = Pipeline<RING, MAX_POINTS>;

@@ -44,7 +44,7 @@
 //! [`Line::truncated`] (and still drive the split rules), never a panic.
 
 use super::Line;
-use crate::wire::PointRecord;
+use crate::wire::{PointRecord, POINT_RECORD_LEN};
 
 /// The rotation-sense vote saturates here (so a stream that changes scanners re-learns).
 pub const VOTE_CLAMP: i32 = 64;
@@ -371,6 +371,74 @@ impl<const N: usize> Assembler<N> {
         self.offer_general(t_ns, p)
     }
 
+    /// [`Self::offer`] on records still in their wire form (docs/wire-format.md, points
+    /// packet), all with the packet's base time `base_time_ns`: takes the leading records
+    /// that are on `offer`'s common path and returns how many it took. The record after
+    /// them needs the full handling — a non-finite coordinate, a flag (line start or
+    /// reserved), a time overflow (the ingest's checks), or any of `offer`'s other cases.
+    /// The state `offer` keeps per point (previous point, side point, time, rotation vote,
+    /// line length) stays in registers for the whole run instead of going through memory
+    /// at every point; the rules and the arithmetic are `offer`'s, so the lines and every
+    /// counter come out the same (tested against the general path).
+    #[inline]
+    pub fn take_run(&mut self, base_time_ns: u64, records: &[[u8; POINT_RECORD_LEN]]) -> usize {
+        let start = self.line.len;
+        if self.closed || self.reset || start == 0 || start >= N {
+            return 0;
+        }
+        let (Some(lt), Some(last), Some(side)) = (self.last_t, self.last_pt, self.last_side_pt)
+        else {
+            return 0;
+        };
+        let Some(first) = records.first() else {
+            return 0;
+        };
+        // Times as offsets from the packet's base in u32 (the wire's `dt`). With no record
+        // of the packet past u64's end, base + dt never overflows (`checked_add`). The first
+        // record's time is tested against `lt` in full; after it, `t ≥ lt && t − lt ≤ gap`
+        // is `dt ≥ lo && dt − lo ≤ gap` with `lo` the previous record's `dt`.
+        if base_time_ns > u64::MAX - u64::from(u32::MAX) {
+            return 0;
+        }
+        let gap = self.params.gap_ns;
+        let t0 =
+            base_time_ns + u64::from(u32::from_le_bytes([first[0], first[1], first[2], first[3]]));
+        if t0 < lt || t0 - lt > gap {
+            return 0;
+        }
+        // `lt` ≥ base here (else `lo` = 0, which the first record passes: it passed above).
+        let lo = u32::try_from(lt.saturating_sub(base_time_ns)).unwrap_or(u32::MAX);
+        let run = Run {
+            lo,
+            gap: u32::try_from(gap).unwrap_or(u32::MAX),
+            vote: self.vote,
+            last,
+            side,
+        };
+        let cap = (N - start).min(records.len());
+        let line = &mut self.line;
+        let out = (
+            &mut line.x_m[start..start + cap],
+            &mut line.z_m[start..start + cap],
+            &mut line.tag[start..start + cap],
+        );
+        // The side (x′ > 0 or not) a point must keep: a point that keeps it and has
+        // x′ ≠ 0 becomes the side point, which therefore keeps it too.
+        let (k, run) = if side.0 > 0.0 {
+            run.take::<true>(&records[..cap], out)
+        } else {
+            run.take::<false>(&records[..cap], out)
+        };
+        if k > 0 {
+            line.len = start + k;
+            self.vote = run.vote;
+            self.last_pt = Some(run.last);
+            self.last_side_pt = Some(run.side);
+            self.last_t = Some(base_time_ns + u64::from(run.lo));
+        }
+        k
+    }
+
     /// The rotation vote of the step from (xa, za) to (x, z).
     #[inline(always)]
     fn vote_on(&mut self, xa: f32, za: f32, x: f32, z: f32) {
@@ -443,6 +511,68 @@ impl<const N: usize> Assembler<N> {
         // Over capacity: Line::push counts the point in `truncated`.
         let _ = self.line.push(p.x_m, p.z_m, p.tag);
         Offer::Taken
+    }
+}
+
+/// The state [`Assembler::take_run`] carries from point to point, in registers.
+struct Run {
+    /// `dt` of the previous record (the lower bound of the next one's).
+    lo: u32,
+    /// The split parameters' time gap, in the u32 of `dt`.
+    gap: u32,
+    vote: i32,
+    /// The previous point (x′, z′).
+    last: (f32, f32),
+    /// The last point with x′ ≠ 0.
+    side: (f32, f32),
+}
+
+impl Run {
+    /// Takes records into `out` (x′, z′, tag; as long as `records`) while each is on
+    /// `offer`'s common path on the side `RIGHT` (x′ > 0); returns how many. Out of line:
+    /// inlined into the ingest's loop, its state did not fit the registers left there.
+    #[inline(never)]
+    fn take<const RIGHT: bool>(
+        mut self,
+        records: &[[u8; POINT_RECORD_LEN]],
+        out: (&mut [f32], &mut [f32], &mut [u32]),
+    ) -> (usize, Self) {
+        let (xd, zd, td) = out;
+        let mut k = 0;
+        for (((rec, xo), zo), to) in records.iter().zip(xd).zip(zd).zip(td) {
+            let word =
+                |at: usize| u32::from_le_bytes([rec[at], rec[at + 1], rec[at + 2], rec[at + 3]]);
+            // Field offsets as in `PointRecord::parse_array`: 0 dt, 4 x, 8 z, 12 intensity
+            // and 14 flags, 16 tag.
+            let (x, z) = (f32::from_bits(word(4)), f32::from_bits(word(8)));
+            let dt = word(0);
+            if !x.is_finite()
+                || !z.is_finite()
+                || word(12) >> 16 != 0
+                || dt < self.lo
+                || dt - self.lo > self.gap
+                || (x > 0.0) != RIGHT
+            {
+                break;
+            }
+            let (xa, za) = self.last;
+            let c = xa * z - za * x;
+            if c > 0.0 {
+                self.vote = (self.vote + 1).min(VOTE_CLAMP);
+            } else if c < 0.0 {
+                self.vote = (self.vote - 1).max(-VOTE_CLAMP);
+            }
+            self.last = (x, z);
+            if x != 0.0 {
+                self.side = (x, z);
+            }
+            self.lo = dt;
+            *xo = x;
+            *zo = z;
+            *to = word(16);
+            k += 1;
+        }
+        (k, self)
     }
 }
 
@@ -594,6 +724,123 @@ mod tests {
                 "{geometry:?}: {fast} {splits}"
             );
         }
+    }
+
+    /// `take_run` takes exactly the points `offer` would take on its common path, with the
+    /// same state after them: two assemblers fed the same odd stream (flags, reserved
+    /// flags, non-finite coordinates, time gaps both ways, side changes, x′ = 0, points over
+    /// capacity, closes), one in runs of wire records through `take_run` with
+    /// `offer_general` for the record a run stops at, one through `offer_general` only,
+    /// give the same lines, counters and rotation sense.
+    #[test]
+    fn take_run_is_the_general_rules() {
+        let mut r = 11u64;
+        let mut u = || {
+            r = r
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((r >> 40) as f32) / ((1u64 << 24) as f32)
+        };
+        let base = 1_000_000u64;
+        let (mut in_runs, mut splits) = (0, 0);
+        for geometry in [
+            GeometrySplit::Auto,
+            GeometrySplit::Always,
+            GeometrySplit::Never,
+        ] {
+            let mut a = Assembler::<64>::new();
+            let mut b = Assembler::<64>::new();
+            let params = SplitParams {
+                gap_ns: 5_000,
+                geometry,
+            };
+            a.set_params(params);
+            b.set_params(params);
+            let mut dt = 0u32;
+            // Records with what each means to the ingest: None = dropped before assembly.
+            let mut recs: Vec<[u8; POINT_RECORD_LEN]> = Vec::new();
+            let mut meaning: Vec<Option<PointRecord>> = Vec::new();
+            for k in 0..20_000u32 {
+                let v = u();
+                dt = if v < 0.01 {
+                    dt + 10_000
+                } else if v < 0.015 {
+                    dt.saturating_sub(20_000)
+                } else {
+                    dt + 1_000
+                };
+                let ang = u() * 6.3;
+                let mut p = pt(5.0 * libm::sinf(ang), 5.0 * libm::cosf(ang), k);
+                p.dt_ns = dt;
+                if u() < 0.05 {
+                    p.x_m = 0.0;
+                }
+                p.line_start = u() < 0.002;
+                let mut rec = [0u8; POINT_RECORD_LEN];
+                p.emit(&mut rec, 0).unwrap();
+                let odd = u();
+                if odd < 0.002 {
+                    rec[4..8].copy_from_slice(&f32::NAN.to_le_bytes());
+                } else if odd < 0.004 {
+                    rec[15] = 0x80;
+                } else if odd < 0.006 {
+                    rec[0..4].copy_from_slice(&u32::MAX.to_le_bytes());
+                }
+                meaning.push(PointRecord::parse_array(&rec).ok());
+                recs.push(rec);
+            }
+            // Near the end of u64's range the last records' times overflow.
+            let base = if geometry == GeometrySplit::Never {
+                u64::MAX - 15_000_000
+            } else {
+                base
+            };
+            let mut i = 0;
+            while i < recs.len() {
+                if u() < 0.001 {
+                    assert_eq!(a.close(SplitReason::SeqGap), b.close(SplitReason::SeqGap));
+                }
+                let end = (i + 1 + (u() * 100.0) as usize).min(recs.len());
+                let k = a.take_run(base, &recs[i..end]);
+                for (j, m) in meaning[i..i + k].iter().enumerate() {
+                    let p = m.expect("take_run takes only valid records");
+                    let t = base.checked_add(u64::from(p.dt_ns)).expect("in range");
+                    assert_eq!(b.offer_general(t, &p), Offer::Taken, "record {}", i + j);
+                }
+                in_runs += k;
+                i += k;
+                if i == end {
+                    continue;
+                }
+                // The record the run stopped at, as the ingest handles it.
+                if let Some(p) = meaning[i] {
+                    if let Some(t) = base.checked_add(u64::from(p.dt_ns)) {
+                        let (ra, rb) = (a.offer(t, &p), b.offer_general(t, &p));
+                        assert_eq!(ra, rb, "record {i}");
+                        if let Offer::Split(_) = ra {
+                            splits += 1;
+                            assert_eq!(a.line.len, b.line.len);
+                            assert_eq!(a.line.x_m[..a.line.len], b.line.x_m[..b.line.len]);
+                            assert_eq!(a.line.z_m[..a.line.len], b.line.z_m[..b.line.len]);
+                            assert_eq!(a.line.tag[..a.line.len], b.line.tag[..b.line.len]);
+                            assert_eq!(a.offer(t, &p), b.offer_general(t, &p));
+                        }
+                    }
+                }
+                i += 1;
+                assert_eq!(a.counters(), b.counters(), "record {i}");
+                assert_eq!(a.rotation_sense(), b.rotation_sense());
+                assert_eq!(
+                    (a.last_t, a.last_pt, a.last_side_pt),
+                    (b.last_t, b.last_pt, b.last_side_pt)
+                );
+            }
+            assert_eq!(a.close(SplitReason::End), b.close(SplitReason::End));
+            assert_eq!(a.line.len, b.line.len);
+            assert_eq!(a.line.tag[..a.line.len], b.line.tag[..b.line.len]);
+            assert_eq!(a.counters(), b.counters());
+        }
+        assert!(in_runs > 15_000 && splits > 1_000, "{in_runs} {splits}");
     }
 
     /// Every combination of rotation direction and returns above: one line per revolution,

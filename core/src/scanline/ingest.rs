@@ -295,6 +295,17 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
             let first = cur.next;
             while cur.next < cur.count {
                 let at = HEADER_LEN + POINTS_PREFIX_LEN + cur.next * POINT_RECORD_LEN;
+                // Most records continue the open line: the assembler takes those in runs
+                // straight from the ring; the one a run stops at goes the full way below.
+                if let Some(tail) = a.get(at..) {
+                    let (records, _) = tail.as_chunks::<POINT_RECORD_LEN>();
+                    let records = &records[..records.len().min(cur.count - cur.next)];
+                    let taken = self.asm.take_run(cur.base_time_ns, records);
+                    if taken > 0 {
+                        cur.next += taken;
+                        continue;
+                    }
+                }
                 // Parse in place when the record is contiguous; copy it out only when it
                 // straddles the ring's seam. The scanner checked the packet is all there.
                 let parsed = match a.get(at..).and_then(|r| r.first_chunk()) {
