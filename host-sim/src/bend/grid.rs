@@ -216,6 +216,7 @@ impl CellOf {
     }
 
     /// `d ≥ 0` (inside the box), so truncation is the floor.
+    #[inline]
     fn axis(&self, d: f64, n: usize) -> usize {
         let q = d * self.inv;
         let k = q as usize;
@@ -223,9 +224,17 @@ impl CellOf {
         let k = if frac > 1e-6 && frac < 1.0 - 1e-6 {
             k
         } else {
-            (d / self.cell) as usize
+            self.divided(d)
         };
         k.min(n - 1)
+    }
+
+    /// The division near a cell boundary, out of line: inlined, the compiler computes it
+    /// for every point and selects the result (a `divsd` per axis and pass).
+    #[cold]
+    #[inline(never)]
+    fn divided(&self, d: f64) -> usize {
+        (d / self.cell) as usize
     }
 
     fn at(&self, x: f64, y: f64) -> usize {

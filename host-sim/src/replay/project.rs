@@ -18,6 +18,9 @@ pub struct PoseCursor<'a> {
     /// The last heading (radians) and its sine and cosine: a vehicle driving straight keeps
     /// one heading over many points, and the same heading gives the same bits.
     sin_cos: (u64, f64, f64),
+    /// The segment whose heading change `dh` (degrees, along the shorter arc) was last
+    /// computed, and that change: points come many to a segment, and `%` is a libm call.
+    turn: (usize, f64),
 }
 
 impl<'a> PoseCursor<'a> {
@@ -27,6 +30,7 @@ impl<'a> PoseCursor<'a> {
             samples: &traj.samples,
             k: 0,
             sin_cos: (f64::NAN.to_bits(), f64::NAN, f64::NAN),
+            turn: (usize::MAX, 0.0),
         }
     }
 
@@ -48,12 +52,16 @@ impl<'a> PoseCursor<'a> {
         }
         let (a, b) = (&s[self.k], &s[self.k + 1]);
         let w = ((t - a.t) / (b.t - a.t)).clamp(0.0, 1.0);
-        let mut dh = (b.heading_deg - a.heading_deg) % 360.0;
-        if dh > 180.0 {
-            dh -= 360.0;
-        } else if dh < -180.0 {
-            dh += 360.0;
+        if self.turn.0 != self.k {
+            let mut dh = (b.heading_deg - a.heading_deg) % 360.0;
+            if dh > 180.0 {
+                dh -= 360.0;
+            } else if dh < -180.0 {
+                dh += 360.0;
+            }
+            self.turn = (self.k, dh);
         }
+        let dh = self.turn.1;
         let h = (a.heading_deg + dh * w).to_radians();
         if h.to_bits() != self.sin_cos.0 {
             let (sin_h, cos_h) = h.sin_cos();
