@@ -40,39 +40,81 @@ pub fn remove_short(input: &BendInput, tracks: Vec<Track>, params: &BendParams) 
         .collect()
 }
 
-/// Share of a track's points that have at least two points of the cloud in the height
-/// band `[vehicle_band_low_m, vehicle_band_high_m]` above them within `vehicle_radius_m`.
+/// Whether the cloud has at least two points in the height band
+/// `[vehicle_band_low_m, vehicle_band_high_m]` above `q` within `vehicle_radius_m`.
+fn covered(input: &BendInput, grid: &PointGrid, q: [f64; 3], params: &BendParams) -> bool {
+    let mut n = 0;
+    grid.for_each_within(input.x, input.y, q[0], q[1], params.vehicle_radius_m, |i| {
+        let dz = input.z[i] - q[2];
+        if dz >= params.vehicle_band_low_m && dz <= params.vehicle_band_high_m {
+            n += 1;
+        }
+    });
+    n >= 2
+}
+
+/// Share of a track's points that are covered (see [`covered`]).
 pub fn covered_share(input: &BendInput, grid: &PointGrid, t: &Track, params: &BendParams) -> f64 {
     if t.xyz.is_empty() {
         return 0.0;
     }
-    let mut covered = 0usize;
-    for &q in &t.xyz {
-        let mut n = 0;
-        grid.for_each_within(input.x, input.y, q[0], q[1], params.vehicle_radius_m, |i| {
-            let dz = input.z[i] - q[2];
-            if dz >= params.vehicle_band_low_m && dz <= params.vehicle_band_high_m {
-                n += 1;
-            }
-        });
-        if n >= 2 {
-            covered += 1;
-        }
-    }
-    covered as f64 / t.xyz.len() as f64
+    let n = t
+        .xyz
+        .iter()
+        .filter(|&&q| covered(input, grid, q, params))
+        .count();
+    n as f64 / t.xyz.len() as f64
 }
 
-/// Filter 2: removes tracks under vehicles (see [`covered_share`]).
+/// Shortest uncovered stretch of a covered track that filter 2 keeps, metres: twice the
+/// shortest edge, so that the few uncovered vertices at a vehicle's ends never stay.
+const UNCOVERED_KEEP_M: f64 = 2.0;
+
+/// Filter 2: removes tracks under vehicles. A track with at least `vehicle_share` of its
+/// points covered (see [`covered`]) runs along a vehicle's foot, or along a curb beside
+/// parked vehicles that overhang it: its covered points go, and its uncovered stretches of
+/// at least [`UNCOVERED_KEEP_M`] stay as tracks of their own (the curb between the
+/// vehicles).
 pub fn remove_under_objects(
     input: &BendInput,
     grid: &PointGrid,
     tracks: Vec<Track>,
     params: &BendParams,
 ) -> Vec<Track> {
-    tracks
-        .into_iter()
-        .filter(|t| covered_share(input, grid, t, params) < params.vehicle_share)
-        .collect()
+    let mut out = Vec::with_capacity(tracks.len());
+    for t in tracks {
+        let cov: Vec<bool> = t
+            .xyz
+            .iter()
+            .map(|&q| covered(input, grid, q, params))
+            .collect();
+        let n = cov.len();
+        let share = cov.iter().filter(|&&c| c).count() as f64 / n.max(1) as f64;
+        if share < params.vehicle_share {
+            out.push(t);
+            continue;
+        }
+        let mut k = 0;
+        while k < n {
+            if cov[k] {
+                k += 1;
+                continue;
+            }
+            let start = k;
+            while k < n && !cov[k] {
+                k += 1;
+            }
+            let piece = Track {
+                points: t.points[start..k].to_vec(),
+                xyz: t.xyz[start..k].to_vec(),
+                side: t.side,
+            };
+            if track_length_m(input, &piece) >= UNCOVERED_KEEP_M {
+                out.push(piece);
+            }
+        }
+    }
+    out
 }
 
 /// Whether segments ab and cd cross (touching at an end point does not count).

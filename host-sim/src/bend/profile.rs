@@ -228,8 +228,10 @@ const CUT_MIN_RISE_M: f64 = 0.015;
 /// Distance behind the toe at which [`CUT_MIN_RISE_M`] is measured, metres.
 const CUT_RISE_AT_M: f64 = 0.25;
 
-/// Steepest ground behind a curb cut's toe (a ramp of 1:3), as a slope.
-const CUT_MAX_RAMP: f64 = 0.35;
+/// Steepest ground behind a curb cut's toe, as a slope: a ramp may climb a 250 mm
+/// sidewalk over 0.5 m (1:2), far steeper than a road's crossfall, far flatter than a
+/// curb's face or a car's flank.
+const CUT_MAX_RAMP: f64 = 0.6;
 
 /// Largest RMS of the two lines of a curb cut's profile about its points, metres: twice
 /// the largest range noise of the scanners simulated and modelled.
@@ -241,7 +243,7 @@ const CUT_MAX_RMS_M: f64 = 0.02;
 /// or lowered sidewalk behind it, rising away from it. The sorted points are split in two
 /// where two independent least-squares lines fit them best; the split is accepted as the
 /// toe when the road part is ground-like (slope under `profile_max_slope`), the part
-/// behind it rises no steeper than a 1:3 ramp and at least [`CUT_MIN_RISE_M`] above the
+/// behind it rises no steeper than [`CUT_MAX_RAMP`] and at least [`CUT_MIN_RISE_M`] above the
 /// road's line [`CUT_RISE_AT_M`] behind the toe (and never falls below it at the toe), the
 /// lines fit within [`CUT_MAX_RMS_M`], ground is seen within 0.15 m on both sides, and the
 /// toe lies within [`CUT_MAX_OFFSET_M`] of the centre. Meant only for continuing a track

@@ -618,13 +618,10 @@ fn timing_300_m() {
 }
 
 /// A curb cut with no lip at the end of the drive, from s = 22 m on the left: the toe is
-/// only the break of slope between the flat road and a 20 % ramp behind it, ρ has no peak
-/// and the core gives no candidate there, and no track waits past the cut to bridge to.
-/// The track along the curb follows the break to the end of the scanned stretch (the left
-/// toe is seen up to s = 34.81 m); without cut following it stops within a few gap steps of
-/// the cut's start.
-#[test]
-fn a_curb_cut_without_lip_is_followed_to_the_end_of_the_drive() {
+/// only the break of slope between the flat road and a ramp behind it (rising at `slope`
+/// up to `height`), ρ has no peak and the core gives no candidate there, and no track waits
+/// past the cut to bridge to.
+fn cut_at_end_scene(slope: f64, height: f64) -> Scene {
     fn cut_at_end(s: f64) -> Option<(f64, f64, f64)> {
         if s >= 22.0 {
             Some((5.0, 0.0, 0.0))
@@ -640,31 +637,60 @@ fn a_curb_cut_without_lip_is_followed_to_the_end_of_the_drive() {
     for i in 0..sc.x.len() {
         let (s, u) = (sc.x[i] - X0, sc.y[i] - Y0);
         if s >= 22.0 && u > 5.0 {
-            sc.z[i] += (0.2 * (u - 5.0)).min(0.15);
+            sc.z[i] += (slope * (u - 5.0)).min(height);
         }
     }
     let x = sc.x.clone();
     sc.candidates
         .retain(|c| c.side == Side::Right || x[c.point as usize] - X0 < 22.0);
-    let reach = |edges: &[EdgeLine]| {
-        edges
-            .iter()
-            .filter(|e| e.side == Side::Left)
-            .flat_map(|e| e.points.iter().map(|p| p[0] - X0))
-            .fold(f64::MIN, f64::max)
-    };
+    sc
+}
+
+/// The farthest s reached by a left edge.
+fn left_reach(edges: &[EdgeLine]) -> f64 {
+    edges
+        .iter()
+        .filter(|e| e.side == Side::Left)
+        .flat_map(|e| e.points.iter().map(|p| p[0] - X0))
+        .fold(f64::MIN, f64::max)
+}
+
+/// The track along the curb follows a lipless cut's break of slope (a 1:5 ramp) to the end
+/// of the scanned stretch (the left toe is seen up to s = 34.81 m); without cut following it
+/// stops within a few gap steps of the cut's start.
+#[test]
+fn a_curb_cut_without_lip_is_followed_to_the_end_of_the_drive() {
+    let sc = cut_at_end_scene(0.2, 0.15);
     let off = BendParams {
         cut_follow_max_m: 0.0,
         ..BendParams::default()
     };
     let without = extract_edges(&sc.input(), &off);
     assert!(
-        reach(&without) < 23.5,
+        left_reach(&without) < 23.5,
         "without: to s = {}",
-        reach(&without)
+        left_reach(&without)
     );
     let with = extract_edges(&sc.input(), &BendParams::default());
-    assert!(reach(&with) > 33.5, "with: to s = {}", reach(&with));
+    assert!(
+        left_reach(&with) > 33.5,
+        "with: to s = {}",
+        left_reach(&with)
+    );
+    for e in with.iter().filter(|e| e.side == Side::Left) {
+        for &p in &e.points {
+            assert!(dist_to_toe(&sc, Side::Left, p) < 0.05, "{p:?} off the toe");
+        }
+    }
+}
+
+/// A cut in a high curb whose ramp climbs the full 0.25 m over 0.5 m (1:2) is followed as
+/// well: the break of slope is the toe however steep the ramp behind it.
+#[test]
+fn a_curb_cut_with_a_steep_ramp_is_followed() {
+    let sc = cut_at_end_scene(0.5, 0.25);
+    let with = extract_edges(&sc.input(), &BendParams::default());
+    assert!(left_reach(&with) > 33.5, "to s = {}", left_reach(&with));
     for e in with.iter().filter(|e| e.side == Side::Left) {
         for &p in &e.points {
             assert!(dist_to_toe(&sc, Side::Left, p) < 0.05, "{p:?} off the toe");
