@@ -181,6 +181,15 @@ pub struct QiuParams {
     /// Largest sideways offset of the next segment's start from the current segment's line
     /// when joining, metres. Not in the paper.
     pub join_lateral_m: f64,
+    /// Two chains of one side that line up (the joins' γ and `join_lateral_m`) across a gap
+    /// longer than `join_gap_m` and at most this are joined when the ground across the
+    /// straight line between them steps up outward by `min_step_m` to `max_step_m` over
+    /// most of it (see `refine::bridge_gaps`), metres; 0 turns it off. Not in the paper. A
+    /// curb cut without a lip (a ramp rising from the toe) has no candidates, as no
+    /// pavement point beside the ramp's foot lies a β lower; its toe is still an edge.
+    /// 13 m: the longest cut (12 m) and a little; an intersection's mouth, as wide or
+    /// wider, is flat across and fails the step.
+    pub bridge_gap_m: f64,
     /// Chains shorter than this are dropped ("the longest … is considered to be the best
     /// road edge"), metres. Not in the paper.
     pub min_chain_m: f64,
@@ -235,6 +244,7 @@ impl Default for QiuParams {
             join_gap_m: 5.0,
             join_angle_deg: 15.0,
             join_lateral_m: 0.3,
+            bridge_gap_m: 13.0,
             min_chain_m: 3.0,
             max_chain_overlap: 0.5,
             height_band_m: [0.15, 0.6],

@@ -406,9 +406,14 @@ pub fn fit_segments(
 /// trajectory, the directions differ by at most γ and `b`'s start lies within
 /// `join_lateral_m` of the line of `a`'s last segment. Returns the gap.
 fn continues(a: &Chain, b: &Chain, params: &QiuParams) -> Option<f64> {
+    continues_within(a, b, params, params.join_gap_m)
+}
+
+/// [`continues`] with a gap of at most `max_gap` metres.
+fn continues_within(a: &Chain, b: &Chain, params: &QiuParams, max_gap: f64) -> Option<f64> {
     let (ea, sb) = (a.pts.last()?, b.pts.first()?);
     let gap = (sb[0] - ea[0]).hypot(sb[1] - ea[1]);
-    if gap > params.join_gap_m || b.s[0] < a.s[a.s.len() - 1] - params.join_lateral_m {
+    if gap > max_gap || b.s[0] < a.s[a.s.len() - 1] - params.join_lateral_m {
         return None;
     }
     if let Some(da) = a.direction(true) {
@@ -462,6 +467,82 @@ pub fn join_chains(mut pieces: Vec<Chain>, params: &QiuParams) -> Vec<Chain> {
         }
     }
     out
+}
+
+/// Joins chains of one side across gaps longer than the joins of [`join_chains`] bridge,
+/// up to `bridge_gap_m`, where the ground says an edge runs on between them: the straight
+/// line from one chain's end to the next one's start (lined up as [`continues`] asks),
+/// with a vertex every `step` metres, its height steps measured by `measure`, must be
+/// measured over at least half its length, step up outward by `min_step_m` to
+/// `max_step_m` (length-weighted median) and nowhere above `max_step_m`. A curb cut
+/// without a lip passes (its ramp rises from the toe, yet gives no candidates: no pavement
+/// point beside the ramp's foot lies a β lower); an intersection's mouth is flat across
+/// and a parked car's side too high. Lines across the trajectory are left as they are.
+pub fn bridge_gaps(
+    mut chains: Vec<Chain>,
+    params: &QiuParams,
+    step: f64,
+    measure: &dyn Fn(&mut Chain),
+) -> Vec<Chain> {
+    if params.bridge_gap_m <= 0.0 {
+        return chains;
+    }
+    chains.sort_by(|a, b| {
+        a.side
+            .cmp(&b.side)
+            .then(a.across.cmp(&b.across))
+            .then(a.s[0].total_cmp(&b.s[0]))
+    });
+    let mut i = 0;
+    while i < chains.len() {
+        if chains[i].across {
+            i += 1;
+            continue;
+        }
+        // The nearest later chain that the ground lets this one join.
+        let mut options: Vec<(usize, f64)> = (i + 1..chains.len())
+            .filter(|&k| chains[k].side == chains[i].side && !chains[k].across)
+            .filter_map(|k| {
+                continues_within(&chains[i], &chains[k], params, params.bridge_gap_m)
+                    .map(|g| (k, g))
+            })
+            .collect();
+        options.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+        let joined = options.into_iter().find_map(|(k, _)| {
+            let (a, b) = (&chains[i], &chains[k]);
+            let (ea, sb) = (a.pts[a.pts.len() - 1], b.pts[0]);
+            let mut bridge = densify(
+                &Chain {
+                    side: a.side,
+                    pts: vec![ea, sb],
+                    s: vec![a.s[a.s.len() - 1], b.s[0]],
+                    h: vec![f64::NAN; 2],
+                    across: false,
+                },
+                step,
+            );
+            measure(&mut bridge);
+            let (measured, wall) = measured_and_wall_shares(&bridge, params.max_step_m);
+            let stepped = median_step(&bridge)
+                .is_some_and(|h| (params.min_step_m..=params.max_step_m).contains(&h));
+            (measured >= 0.5 && wall == 0.0 && stepped).then_some((k, bridge))
+        });
+        match joined {
+            Some((k, bridge)) => {
+                let b = chains.remove(k);
+                let a = &mut chains[i];
+                let inner = 1..bridge.pts.len() - 1;
+                a.pts.extend_from_slice(&bridge.pts[inner.clone()]);
+                a.s.extend_from_slice(&bridge.s[inner.clone()]);
+                a.h.extend_from_slice(&bridge.h[inner]);
+                a.pts.extend_from_slice(&b.pts);
+                a.s.extend_from_slice(&b.s);
+                a.h.extend_from_slice(&b.h);
+            }
+            None => i += 1,
+        }
+    }
+    chains
 }
 
 /// §3.4.2 step 4: chains shorter than `min_chain_m` are dropped; of chains on the same
