@@ -751,9 +751,27 @@ pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParam
         for cluster in euclidean_clusters(&xy_of(&all), params.cluster_tolerance_m) {
             let members: Vec<usize> = cluster.iter().map(|&k| all[k]).collect();
             let n_kept = members.iter().filter(|&&i| is_kept[i]).count();
+            let (d_lo, d_hi) = members
+                .iter()
+                .fold((f64::INFINITY, 0.0f64), |(lo, hi), &i| {
+                    (lo.min(pts[i].d.abs()), hi.max(pts[i].d.abs()))
+                });
             if n_kept as f64 >= params.cluster_keep_share * members.len() as f64 && n_kept > 0 {
                 groups.push(members);
                 continue;
+            }
+            // A cluster that leaves the road's offsets is kept whole when it is one thin
+            // line (a corner's arc), not a patch of scattered candidates.
+            if params.cluster_keep_spread_m > 0.0
+                && d_hi - d_lo >= params.cluster_keep_spread_m
+                && members.len() >= params.min_cluster_points
+            {
+                if let Some(c) = fit_segments(pts, &members, &[], params) {
+                    if is_thin_line(&c, pts, &members, 2.0 * params.segment_tolerance_m) {
+                        pieces.push(c);
+                        continue;
+                    }
+                }
             }
             let sub: Vec<usize> = members.into_iter().filter(|&i| is_kept[i]).collect();
             for c in euclidean_clusters(&xy_of(&sub), params.cluster_tolerance_m) {
@@ -770,6 +788,33 @@ pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParam
         }
     }
     join_chains(pieces, params)
+}
+
+/// Whether at least 3 in 4 of a cluster's points lie within `tol` of the line fitted to it
+/// (twice the fit's tolerance holds a curb's band of candidates; scattered candidates sit
+/// up to metres off the line of their bin medians).
+fn is_thin_line(c: &Chain, pts: &[EdgePoint], members: &[usize], tol: f64) -> bool {
+    if c.pts.len() < 2 {
+        return false;
+    }
+    let near = members
+        .iter()
+        .filter(|&&i| {
+            let p = pts[i].p;
+            c.pts.windows(2).any(|w| {
+                let (a, b) = (w[0], w[1]);
+                let (ux, uy) = (b[0] - a[0], b[1] - a[1]);
+                let l2 = ux * ux + uy * uy;
+                let t = if l2 > 0.0 {
+                    (((p[0] - a[0]) * ux + (p[1] - a[1]) * uy) / l2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                (p[0] - a[0] - t * ux).hypot(p[1] - a[1] - t * uy) <= tol
+            })
+        })
+        .count();
+    4 * near >= 3 * members.len()
 }
 
 /// The chain with vertices inserted so that none is more than `step` from the next (the
@@ -1131,5 +1176,77 @@ mod tests {
         let (measured, wall) = measured_and_wall_shares(&unmeasured, 0.2);
         assert!((measured - 7.5 / 21.0).abs() < 1e-9, "{measured}");
         assert!((wall - 3.0 / 21.0).abs() < 1e-9, "{wall}");
+    }
+
+    /// Two lined-up curbs at y = 5 with a 10 m gap (x 10..20): longer than the joins
+    /// bridge, so only `bridge_gaps` joins them, and only where the ground measured along
+    /// the gap steps up outward as a ramp does; flat ground (an intersection's mouth), a
+    /// wall-sized step or a gap longer than `bridge_gap_m` leaves two chains.
+    #[test]
+    fn a_gap_is_bridged_only_where_the_ground_steps_up_outward() {
+        let p = QiuParams::default();
+        let curb = |x0: f64, x1: f64| Chain {
+            side: Side::Left,
+            pts: vec![[x0, 5.0, 0.0], [x1, 5.0, 0.0]],
+            s: vec![x0, x1],
+            h: vec![0.15, 0.15],
+            across: false,
+        };
+        let run = |gap_end: f64, step_m: f64| {
+            let chains = vec![curb(gap_end, gap_end + 10.0), curb(0.0, 10.0)];
+            bridge_gaps(chains, &p, 1.0, &|c: &mut Chain| {
+                for h in &mut c.h {
+                    *h = step_m;
+                }
+            })
+        };
+        let ramp = run(20.0, 0.05);
+        assert_eq!(ramp.len(), 1);
+        let c = &ramp[0];
+        assert_eq!((c.pts[0][0], c.pts[c.pts.len() - 1][0]), (0.0, 30.0));
+        assert!(c.s.windows(2).all(|w| w[1] > w[0]), "{:?}", c.s);
+        assert!(c.pts.windows(2).all(|w| w[1][0] - w[0][0] <= 1.0 + 1e-9));
+        assert_eq!(run(20.0, 0.0).len(), 2, "flat ground");
+        assert_eq!(run(20.0, 0.8).len(), 2, "a wall");
+        assert_eq!(
+            run(10.0 + p.bridge_gap_m + 0.5, 0.05).len(),
+            2,
+            "too long a gap"
+        );
+        let off = QiuParams {
+            bridge_gap_m: 0.0,
+            ..QiuParams::default()
+        };
+        let chains = vec![curb(0.0, 10.0), curb(20.0, 30.0)];
+        assert_eq!(bridge_gaps(chains, &off, 1.0, &|_: &mut Chain| {}).len(), 2);
+    }
+
+    /// No candidate kept by the width step: a corner's arc (offset 5 → 6.9 m, more than
+    /// `cluster_keep_spread_m`) is kept as a line all the same; a patch of scattered
+    /// candidates with the same spread is not, and with the rule off neither is.
+    #[test]
+    fn an_arc_leaving_the_road_width_is_kept_a_scattered_patch_not() {
+        let mut pts = Vec::new();
+        for k in 0..56 {
+            let t = (k as f64 * 0.1 / 8.0).min(40f64.to_radians());
+            let jitter = if k % 2 == 0 { 0.02 } else { -0.02 };
+            pts.push(ep(8.0 * t.sin(), 13.0 - (8.0 + jitter) * t.cos()));
+        }
+        for i in 0..13 {
+            for j in 0..5 {
+                pts.push(ep(20.0 + i as f64 * 0.5, 5.0 + j as f64 * 0.5));
+            }
+        }
+        let p = QiuParams::default();
+        let chains = refine_by_continuity(&pts, &[], &p);
+        assert_eq!(chains.len(), 1, "{chains:?}");
+        let c = &chains[0];
+        assert!(c.pts.iter().all(|q| q[0] < 6.0));
+        assert!(c.length_m() > 4.5, "{}", c.length_m());
+        let off = QiuParams {
+            cluster_keep_spread_m: 0.0,
+            ..QiuParams::default()
+        };
+        assert!(refine_by_continuity(&pts, &[], &off).is_empty());
     }
 }
