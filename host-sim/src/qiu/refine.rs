@@ -1205,7 +1205,11 @@ mod tests {
         let c = &ramp[0];
         assert_eq!((c.pts[0][0], c.pts[c.pts.len() - 1][0]), (0.0, 30.0));
         assert!(c.s.windows(2).all(|w| w[1] > w[0]), "{:?}", c.s);
-        assert!(c.pts.windows(2).all(|w| w[1][0] - w[0][0] <= 1.0 + 1e-9));
+        // The two curbs' vertices and the bridge's nine, 1 m apart, between them.
+        assert_eq!(c.pts.len(), 13);
+        assert!(c.pts[1..12]
+            .windows(2)
+            .all(|w| (w[1][0] - w[0][0] - 1.0).abs() < 1e-9));
         assert_eq!(run(20.0, 0.0).len(), 2, "flat ground");
         assert_eq!(run(20.0, 0.8).len(), 2, "a wall");
         assert_eq!(
