@@ -332,6 +332,9 @@ fn process_section(
     }
     // Ground on both sides (see `QiuParams::min_step_m`), then §3.4.2 step 4.
     chains.retain(|c| is_edge_step(c, params));
+    let chains = refine::bridge_gaps(chains, params, STEP_SAMPLE_M, &|c| {
+        grid.measure_steps(c, params.height_band_m)
+    });
     let chains = refine::keep_longest(chains, params);
     rep.chains = chains.len();
     let clipped: Vec<Chain> = chains

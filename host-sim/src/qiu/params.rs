@@ -167,6 +167,15 @@ pub struct QiuParams {
     /// where its offset leaves the road's width; 0.5: a majority. Above 1, the paper's
     /// point-by-point rule.
     pub cluster_keep_share: f64,
+    /// A Euclidean cluster whose offsets from the trajectory span at least this, metres,
+    /// is kept whole too, however little of it the road-width step kept: a corner's arc
+    /// leaves the road's width by design, and where no straight curb joins it (the drive
+    /// starts or ends at the corner, or the curb before it is a cut or hidden) the share
+    /// rule loses it. The height step still judges the line (road noise is flat, a car's
+    /// end or a wall too high). Not in the paper; 0 turns it off. 1.5 m: five times the
+    /// width step's tolerance, more than a swerve around a parked car moves a curb's
+    /// offset within one cluster.
+    pub cluster_keep_spread_m: f64,
     /// Points of a cluster are summarised every this many metres along its main direction
     /// before fitting line segments. Not in the paper.
     pub bin_m: f64,
@@ -181,6 +190,15 @@ pub struct QiuParams {
     /// Largest sideways offset of the next segment's start from the current segment's line
     /// when joining, metres. Not in the paper.
     pub join_lateral_m: f64,
+    /// Two chains of one side that line up (the joins' γ and `join_lateral_m`) across a gap
+    /// longer than `join_gap_m` and at most this are joined when the ground across the
+    /// straight line between them steps up outward by `min_step_m` to `max_step_m` over
+    /// most of it (see `refine::bridge_gaps`), metres; 0 turns it off. Not in the paper. A
+    /// curb cut without a lip (a ramp rising from the toe) has no candidates, as no
+    /// pavement point beside the ramp's foot lies a β lower; its toe is still an edge.
+    /// 13 m: the longest cut (12 m) and a little; an intersection's mouth, as wide or
+    /// wider, is flat across and fails the step.
+    pub bridge_gap_m: f64,
     /// Chains shorter than this are dropped ("the longest … is considered to be the best
     /// road edge"), metres. Not in the paper.
     pub min_chain_m: f64,
@@ -230,11 +248,13 @@ impl Default for QiuParams {
             cluster_tolerance_m: 0.6,
             min_cluster_points: 5,
             cluster_keep_share: 0.5,
+            cluster_keep_spread_m: 1.5,
             bin_m: 0.5,
             segment_tolerance_m: 0.1,
             join_gap_m: 5.0,
             join_angle_deg: 15.0,
             join_lateral_m: 0.3,
+            bridge_gap_m: 13.0,
             min_chain_m: 3.0,
             max_chain_overlap: 0.5,
             height_band_m: [0.15, 0.6],
@@ -290,6 +310,8 @@ impl QiuParams {
             ("min_rise_beta", self.min_rise_beta),
             ("low_beta_corridor_m", self.low_beta_corridor_m),
             ("low_beta_window_m", self.low_beta_window_m),
+            ("cluster_keep_spread_m", self.cluster_keep_spread_m),
+            ("bridge_gap_m", self.bridge_gap_m),
         ];
         for (name, v) in nonneg {
             if !(v.is_finite() && v >= 0.0) {

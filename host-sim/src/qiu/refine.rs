@@ -406,9 +406,14 @@ pub fn fit_segments(
 /// trajectory, the directions differ by at most γ and `b`'s start lies within
 /// `join_lateral_m` of the line of `a`'s last segment. Returns the gap.
 fn continues(a: &Chain, b: &Chain, params: &QiuParams) -> Option<f64> {
+    continues_within(a, b, params, params.join_gap_m)
+}
+
+/// [`continues`] with a gap of at most `max_gap` metres.
+fn continues_within(a: &Chain, b: &Chain, params: &QiuParams, max_gap: f64) -> Option<f64> {
     let (ea, sb) = (a.pts.last()?, b.pts.first()?);
     let gap = (sb[0] - ea[0]).hypot(sb[1] - ea[1]);
-    if gap > params.join_gap_m || b.s[0] < a.s[a.s.len() - 1] - params.join_lateral_m {
+    if gap > max_gap || b.s[0] < a.s[a.s.len() - 1] - params.join_lateral_m {
         return None;
     }
     if let Some(da) = a.direction(true) {
@@ -462,6 +467,82 @@ pub fn join_chains(mut pieces: Vec<Chain>, params: &QiuParams) -> Vec<Chain> {
         }
     }
     out
+}
+
+/// Joins chains of one side across gaps longer than the joins of [`join_chains`] bridge,
+/// up to `bridge_gap_m`, where the ground says an edge runs on between them: the straight
+/// line from one chain's end to the next one's start (lined up as [`continues`] asks),
+/// with a vertex every `step` metres, its height steps measured by `measure`, must be
+/// measured over at least half its length, step up outward by `min_step_m` to
+/// `max_step_m` (length-weighted median) and nowhere above `max_step_m`. A curb cut
+/// without a lip passes (its ramp rises from the toe, yet gives no candidates: no pavement
+/// point beside the ramp's foot lies a β lower); an intersection's mouth is flat across
+/// and a parked car's side too high. Lines across the trajectory are left as they are.
+pub fn bridge_gaps(
+    mut chains: Vec<Chain>,
+    params: &QiuParams,
+    step: f64,
+    measure: &dyn Fn(&mut Chain),
+) -> Vec<Chain> {
+    if params.bridge_gap_m <= 0.0 {
+        return chains;
+    }
+    chains.sort_by(|a, b| {
+        a.side
+            .cmp(&b.side)
+            .then(a.across.cmp(&b.across))
+            .then(a.s[0].total_cmp(&b.s[0]))
+    });
+    let mut i = 0;
+    while i < chains.len() {
+        if chains[i].across {
+            i += 1;
+            continue;
+        }
+        // The nearest later chain that the ground lets this one join.
+        let mut options: Vec<(usize, f64)> = (i + 1..chains.len())
+            .filter(|&k| chains[k].side == chains[i].side && !chains[k].across)
+            .filter_map(|k| {
+                continues_within(&chains[i], &chains[k], params, params.bridge_gap_m)
+                    .map(|g| (k, g))
+            })
+            .collect();
+        options.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+        let joined = options.into_iter().find_map(|(k, _)| {
+            let (a, b) = (&chains[i], &chains[k]);
+            let (ea, sb) = (a.pts[a.pts.len() - 1], b.pts[0]);
+            let mut bridge = densify(
+                &Chain {
+                    side: a.side,
+                    pts: vec![ea, sb],
+                    s: vec![a.s[a.s.len() - 1], b.s[0]],
+                    h: vec![f64::NAN; 2],
+                    across: false,
+                },
+                step,
+            );
+            measure(&mut bridge);
+            let (measured, wall) = measured_and_wall_shares(&bridge, params.max_step_m);
+            let stepped = median_step(&bridge)
+                .is_some_and(|h| (params.min_step_m..=params.max_step_m).contains(&h));
+            (measured >= 0.5 && wall == 0.0 && stepped).then_some((k, bridge))
+        });
+        match joined {
+            Some((k, bridge)) => {
+                let b = chains.remove(k);
+                let a = &mut chains[i];
+                let inner = 1..bridge.pts.len() - 1;
+                a.pts.extend_from_slice(&bridge.pts[inner.clone()]);
+                a.s.extend_from_slice(&bridge.s[inner.clone()]);
+                a.h.extend_from_slice(&bridge.h[inner]);
+                a.pts.extend_from_slice(&b.pts);
+                a.s.extend_from_slice(&b.s);
+                a.h.extend_from_slice(&b.h);
+            }
+            None => i += 1,
+        }
+    }
+    chains
 }
 
 /// §3.4.2 step 4: chains shorter than `min_chain_m` are dropped; of chains on the same
@@ -670,9 +751,27 @@ pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParam
         for cluster in euclidean_clusters(&xy_of(&all), params.cluster_tolerance_m) {
             let members: Vec<usize> = cluster.iter().map(|&k| all[k]).collect();
             let n_kept = members.iter().filter(|&&i| is_kept[i]).count();
+            let (d_lo, d_hi) = members
+                .iter()
+                .fold((f64::INFINITY, 0.0f64), |(lo, hi), &i| {
+                    (lo.min(pts[i].d.abs()), hi.max(pts[i].d.abs()))
+                });
             if n_kept as f64 >= params.cluster_keep_share * members.len() as f64 && n_kept > 0 {
                 groups.push(members);
                 continue;
+            }
+            // A cluster that leaves the road's offsets is kept whole when it is one thin
+            // line (a corner's arc), not a patch of scattered candidates.
+            if params.cluster_keep_spread_m > 0.0
+                && d_hi - d_lo >= params.cluster_keep_spread_m
+                && members.len() >= params.min_cluster_points
+            {
+                if let Some(c) = fit_segments(pts, &members, &[], params) {
+                    if is_thin_line(&c, pts, &members, 2.0 * params.segment_tolerance_m) {
+                        pieces.push(c);
+                        continue;
+                    }
+                }
             }
             let sub: Vec<usize> = members.into_iter().filter(|&i| is_kept[i]).collect();
             for c in euclidean_clusters(&xy_of(&sub), params.cluster_tolerance_m) {
@@ -689,6 +788,33 @@ pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParam
         }
     }
     join_chains(pieces, params)
+}
+
+/// Whether at least 3 in 4 of a cluster's points lie within `tol` of the line fitted to it
+/// (twice the fit's tolerance holds a curb's band of candidates; scattered candidates sit
+/// up to metres off the line of their bin medians).
+fn is_thin_line(c: &Chain, pts: &[EdgePoint], members: &[usize], tol: f64) -> bool {
+    if c.pts.len() < 2 {
+        return false;
+    }
+    let near = members
+        .iter()
+        .filter(|&&i| {
+            let p = pts[i].p;
+            c.pts.windows(2).any(|w| {
+                let (a, b) = (w[0], w[1]);
+                let (ux, uy) = (b[0] - a[0], b[1] - a[1]);
+                let l2 = ux * ux + uy * uy;
+                let t = if l2 > 0.0 {
+                    (((p[0] - a[0]) * ux + (p[1] - a[1]) * uy) / l2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                (p[0] - a[0] - t * ux).hypot(p[1] - a[1] - t * uy) <= tol
+            })
+        })
+        .count();
+    4 * near >= 3 * members.len()
 }
 
 /// The chain with vertices inserted so that none is more than `step` from the next (the
@@ -1050,5 +1176,81 @@ mod tests {
         let (measured, wall) = measured_and_wall_shares(&unmeasured, 0.2);
         assert!((measured - 7.5 / 21.0).abs() < 1e-9, "{measured}");
         assert!((wall - 3.0 / 21.0).abs() < 1e-9, "{wall}");
+    }
+
+    /// Two lined-up curbs at y = 5 with a 10 m gap (x 10..20): longer than the joins
+    /// bridge, so only `bridge_gaps` joins them, and only where the ground measured along
+    /// the gap steps up outward as a ramp does; flat ground (an intersection's mouth), a
+    /// wall-sized step or a gap longer than `bridge_gap_m` leaves two chains.
+    #[test]
+    fn a_gap_is_bridged_only_where_the_ground_steps_up_outward() {
+        let p = QiuParams::default();
+        let curb = |x0: f64, x1: f64| Chain {
+            side: Side::Left,
+            pts: vec![[x0, 5.0, 0.0], [x1, 5.0, 0.0]],
+            s: vec![x0, x1],
+            h: vec![0.15, 0.15],
+            across: false,
+        };
+        let run = |gap_end: f64, step_m: f64| {
+            let chains = vec![curb(gap_end, gap_end + 10.0), curb(0.0, 10.0)];
+            bridge_gaps(chains, &p, 1.0, &|c: &mut Chain| {
+                for h in &mut c.h {
+                    *h = step_m;
+                }
+            })
+        };
+        let ramp = run(20.0, 0.05);
+        assert_eq!(ramp.len(), 1);
+        let c = &ramp[0];
+        assert_eq!((c.pts[0][0], c.pts[c.pts.len() - 1][0]), (0.0, 30.0));
+        assert!(c.s.windows(2).all(|w| w[1] > w[0]), "{:?}", c.s);
+        // The two curbs' vertices and the bridge's nine, 1 m apart, between them.
+        assert_eq!(c.pts.len(), 13);
+        assert!(c.pts[1..12]
+            .windows(2)
+            .all(|w| (w[1][0] - w[0][0] - 1.0).abs() < 1e-9));
+        assert_eq!(run(20.0, 0.0).len(), 2, "flat ground");
+        assert_eq!(run(20.0, 0.8).len(), 2, "a wall");
+        assert_eq!(
+            run(10.0 + p.bridge_gap_m + 0.5, 0.05).len(),
+            2,
+            "too long a gap"
+        );
+        let off = QiuParams {
+            bridge_gap_m: 0.0,
+            ..QiuParams::default()
+        };
+        let chains = vec![curb(0.0, 10.0), curb(20.0, 30.0)];
+        assert_eq!(bridge_gaps(chains, &off, 1.0, &|_: &mut Chain| {}).len(), 2);
+    }
+
+    /// No candidate kept by the width step: a corner's arc (offset 5 → 6.9 m, more than
+    /// `cluster_keep_spread_m`) is kept as a line all the same; a patch of scattered
+    /// candidates with the same spread is not, and with the rule off neither is.
+    #[test]
+    fn an_arc_leaving_the_road_width_is_kept_a_scattered_patch_not() {
+        let mut pts = Vec::new();
+        for k in 0..56 {
+            let t = (k as f64 * 0.1 / 8.0).min(40f64.to_radians());
+            let jitter = if k % 2 == 0 { 0.02 } else { -0.02 };
+            pts.push(ep(8.0 * t.sin(), 13.0 - (8.0 + jitter) * t.cos()));
+        }
+        for i in 0..13 {
+            for j in 0..5 {
+                pts.push(ep(20.0 + i as f64 * 0.5, 5.0 + j as f64 * 0.5));
+            }
+        }
+        let p = QiuParams::default();
+        let chains = refine_by_continuity(&pts, &[], &p);
+        assert_eq!(chains.len(), 1, "{chains:?}");
+        let c = &chains[0];
+        assert!(c.pts.iter().all(|q| q[0] < 6.0));
+        assert!(c.length_m() > 4.5, "{}", c.length_m());
+        let off = QiuParams {
+            cluster_keep_spread_m: 0.0,
+            ..QiuParams::default()
+        };
+        assert!(refine_by_continuity(&pts, &[], &off).is_empty());
     }
 }
