@@ -12,12 +12,23 @@
 # config packet sets the output mode and the region of interest (`mode:` says which);
 # docs/benchmarks.md shows the runs for both modes.
 #
+# Real time (tools/realtime-lib.sh, as firmware/realtime.sh): the libm build once more with
+# `--realtime` under QEMU's `-icount shift=3,sleep=off` (8 ns per instruction, 1.344 cycles
+# per instruction at 168 MHz), the stream delivered at CHECK_REALTIME_RATE points/s scaled to
+# the 1.5 cycles per instruction of docs/benchmarks.md (default 200 000, the scanner's rate:
+# 200 000 · 1.5 / 1.344 = 223 215 points/s at shift 3); `realtime_dropped_bytes:` says what
+# that run lost, and any loss fails the check (CHECK_REALTIME_RATE=0 skips the run). Then a
+# bisection of CHECK_REALTIME_BISECT steps (default 7, 0 for none) between 50 000 and
+# 400 000 points/s at shift 3 prints the largest rate with no byte dropped, also scaled to
+# CPI 1.5 (`realtime_max_no_drop_points_per_s_cpi1.5:`). Each run takes the whole stream (about
+# 1.5 s per run on the tiny stream).
+#
 # Needs Debian's rustc-web, cargo-web, rust-web-src, lld-19, qemu-system-arm (scripts/test.sh
 # installs them), gcc, binutils and rustup's stable cargo for the host side.
 # Environment: CURBTRACE_BIN (a built `curbtrace` to use instead of building one),
 # FIRMWARE_TARGET_DIR (default firmware/target), CARGO_TARGET_DIR (host build,
 # default target/), QEMU_TIMEOUT seconds per QEMU run (default 600), CHECK_KEEP=1 keeps the
-# work directory.
+# work directory, CHECK_REALTIME_RATE and CHECK_REALTIME_BISECT (above).
 set -euo pipefail
 
 FW=$(cd "$(dirname "$0")" && pwd)
@@ -174,7 +185,42 @@ echo "identical_to_fw_kernel_on_host: $(fig identical "$WORK/cmp-hostloop.txt")"
   die "comparing the libm output failed: $(cat "$WORK/cmp-libm.txt")"
 echo "reference: $reference"
 echo "output_bytes: $(fig output_bytes "$WORK/cmp-libm.txt")"
+
+# --- real time ------------------------------------------------------------------------------
+# shellcheck source=tools/realtime-lib.sh
+. "$FW/tools/realtime-lib.sh"
+RT_ELF="$WORK/fw-libm.elf" RT_STREAM=$STREAM RT_BYTES=$(stat -c %s "$STREAM") RT_POINTS=$points
+RT_SHIFT=3 RT_WORK="$WORK"
+rt_rate=${CHECK_REALTIME_RATE:-200000}
+rt_steps=${CHECK_REALTIME_BISECT:-7}
+rt_dropped=0
+echo "realtime_icount_shift: $RT_SHIFT (cpi $(rt_cpi) at 168 MHz)"
+if [ "$rt_rate" != 0 ]; then
+  log "real time: one run at $rt_rate points/s (CPI 1.5)"
+  rt_at=$(rt_unscaled "$rt_rate")
+  rt_dropped=$(rt_run "$rt_at")
+  echo "realtime_points_per_s_cpi1.5: $rt_rate ($rt_at at shift $RT_SHIFT)"
+  echo "realtime_dropped_bytes: $rt_dropped"
+  echo "realtime_queue_high_water_bytes: $(rt_fig "$rt_at" realtime_queue_high_water_bytes)"
+  if [ "$rt_dropped" = 0 ]; then
+    if cmp -s "$WORK/out-host.bin" "$WORK/out-$rt_at.bin"; then rt_identical=yes; else rt_identical=no; fi
+    echo "realtime_identical: $rt_identical"
+  fi
+fi
+if [ "$rt_steps" != 0 ]; then
+  log "real time: bisecting the largest rate with no drop ($rt_steps steps)"
+  rt_bracket=$(rt_bisect 50000 400000 "$rt_steps")
+  read -r rt_lo rt_hi <<< "$rt_bracket"
+  echo "realtime_max_no_drop_points_per_s: $rt_lo (first with drops: $rt_hi; at shift $RT_SHIFT)"
+  echo "realtime_max_no_drop_points_per_s_cpi1.5: $(rt_scaled "$rt_lo")"
+fi
+
 status=0
+if [ "$rt_dropped" != 0 ]; then
+  log "$rt_dropped bytes dropped at $rt_rate points/s (CPI 1.5)"
+  status=1
+fi
+[ "${rt_identical:-yes}" = yes ] || status=1
 agree=$(fig candidates_agree_percent "$WORK/cmp-micromath.txt")
 if ! awk -v a="$agree" 'BEGIN { exit !(a >= 99) }'; then
   log "micromath candidates agree on only $agree % of the scanlines (need >= 99 %)"
