@@ -20,8 +20,8 @@
 # that run lost, and any loss fails the check (CHECK_REALTIME_RATE=0 skips the run). Then a
 # bisection of CHECK_REALTIME_BISECT steps (default 7, 0 for none) between 50 000 and
 # 400 000 points/s at shift 3 prints the largest rate with no byte dropped, also scaled to
-# CPI 1.5 (`realtime_max_no_drop_points_per_s_cpi1.5:`). Each run takes the whole stream (about
-# 1.5 s per run on the tiny stream).
+# CPI 1.5 (`realtime_max_no_drop_points_per_s_cpi1.5:`). Each run takes the whole stream (1.5–3 s on
+# the tiny stream, about 20 s on curvy).
 #
 # Needs Debian's rustc-web, cargo-web, rust-web-src, lld-19, qemu-system-arm (scripts/test.sh
 # installs them), gcc, binutils and rustup's stable cargo for the host side.
