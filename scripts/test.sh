@@ -94,9 +94,8 @@ CURBTRACE="${CARGO_TARGET_DIR:-$ROOT/target}/release/curbtrace"
 # The default config (every point out, CRC-32) is not the real-time one: check.sh bisects its
 # no-drop rate without the 200 000 points/s run, which the band config below must pass.
 CURBTRACE_BIN="$CURBTRACE" QEMU_TIMEOUT=300 CHECK_REALTIME_RATE=0 firmware/check.sh "$FW_WORK/tiny.bin"
-printf '[kernel]\nroi_x_min_m = -15.0\nroi_x_max_m = 15.0\nroi_z_min_m = -3.0\nroi_z_max_m = -1.5\noutput_mode = 1\n' > "$FW_WORK/band.toml"
 "$CURBTRACE" replay "$FW_WORK/sim/points.laz" --trajectory "$FW_WORK/sim/trajectory.csv" \
-  --config "$FW_WORK/band.toml" --link-checked -o "$FW_WORK/tiny-band-lc.bin"
+  --config firmware/band.toml --link-checked -o "$FW_WORK/tiny-band-lc.bin"
 CURBTRACE_BIN="$CURBTRACE" RATE=200000 firmware/realtime.sh "$FW_WORK/tiny-band-lc.bin"
 
 step "firmware: the USART links under QEMU: the tiny stream's first 500 kB in on USART3 at 115 200 baud, the packets out on USART6, compared with the host core (firmware/usart-test.sh)"
