@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Fuzz smoke runs (part of scripts/test.sh): lint fuzz/, then each core target for 20 s from
-# its committed corpus and every saved crash of those targets; any crash fails. Installs
+# Fuzz smoke runs (part of scripts/test.sh): lint fuzz/, then the core targets side by side
+# from their committed corpora, then every saved crash of those targets; any crash fails. Installs
 # cargo-fuzz when missing.
 #
 # `host_inputs` (the host's LAS/LAZ and trajectory readers) is not fuzzed here by default:
@@ -29,19 +29,39 @@ else
   export RUSTC_BOOTSTRAP=1; FUZZ_TC=()
 fi
 TARGETS=${FUZZ_SMOKE_TARGETS:-wire_parse ingest kernel_points}
+# The smoke runs go without AddressSanitizer (-s none): the core forbids unsafe code, the
+# build is much shorter and the targets run ~8x faster (docs/robustness.md); the long runs
+# in docs/robustness.md used ASan. Each libFuzzer run is one process on one core, so the
+# targets are built first and then fuzzed side by side; each run's log is printed after.
+step "fuzz: building $TARGETS"
 for t in $TARGETS; do
-  step "fuzz: $t for 20 s from fuzz/corpus/$t (any crash fails)"
-  work=$(mktemp -d)
-  # The smoke runs go without AddressSanitizer (-s none): the core forbids unsafe code,
-  # the build is much shorter and the targets run ~8x faster (docs/robustness.md); the
-  # long runs in docs/robustness.md used ASan.
-  san=(-s none); dir="$FUZZ_TARGET"
   feat=(); if [ "$t" = host_inputs ]; then feat=(--features host); fi
-  (cd fuzz && cargo "${FUZZ_TC[@]}" fuzz run "${san[@]}" "${feat[@]}" --target-dir "$dir" \
-    "$t" "$work" "corpus/$t" -- -max_total_time=20 -max_len=65536 -rss_limit_mb=2048 \
-    -malloc_limit_mb=512 -artifact_prefix="$work/")
-  rm -rf "$work"
+  (cd fuzz && cargo "${FUZZ_TC[@]}" fuzz build -s none "${feat[@]}" --target-dir "$FUZZ_TARGET" "$t")
 done
+step "fuzz: $TARGETS side by side for 30 s each from fuzz/corpus/<target> (any crash fails)"
+work=$(mktemp -d)
+pids=()
+for t in $TARGETS; do
+  feat=(); if [ "$t" = host_inputs ]; then feat=(--features host); fi
+  mkdir -p "$work/$t"
+  (cd fuzz && cargo "${FUZZ_TC[@]}" fuzz run -s none "${feat[@]}" --target-dir "$FUZZ_TARGET" \
+    "$t" "$work/$t" "corpus/$t" -- -max_total_time=30 -max_len=65536 -rss_limit_mb=2048 \
+    -malloc_limit_mb=512 -artifact_prefix="$work/$t/") > "$work/$t.log" 2>&1 &
+  pids+=("$!")
+done
+failed=()
+i=0
+for t in $TARGETS; do
+  rc=0; wait "${pids[$i]}" || rc=$?
+  i=$((i + 1))
+  echo "--- fuzz $t (exit status $rc) ---"
+  tail -n 15 "$work/$t.log"
+  [ "$rc" -eq 0 ] || failed+=("$t")
+done
+rm -rf "$work"
+if [ ${#failed[@]} -gt 0 ]; then
+  echo "fuzz: ${failed[*]} failed (a crash, a leak or a timeout; the log above names the input)"; exit 1
+fi
 step "fuzz: every input that once crashed these targets (fuzz/regressions/) runs clean"
 for f in fuzz/regressions/*/*; do
   [ -f "$f" ] || continue
