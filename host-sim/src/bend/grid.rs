@@ -81,19 +81,24 @@ impl PointGrid {
             starts: vec![0u32; nx * ny + 1],
             order: Vec::new(),
         };
-        // The cells are computed twice rather than kept (4 bytes a point more while the
-        // grid is built, for no time measured).
+        // Each kept point's cell, found once for the count and kept for the scatter (4
+        // bytes a kept point while the grid is built).
         let cells = CellOf::new(&g);
+        let mut cell_of = Vec::with_capacity(count);
         for_each_set(&kept, |i| {
-            g.starts[cells.at(x[i], y[i]) + 1] += 1;
+            let c = cells.at(x[i], y[i]);
+            g.starts[c + 1] += 1;
+            cell_of.push(c as u32);
         });
         for c in 0..nx * ny {
             g.starts[c + 1] += g.starts[c];
         }
         let mut fill = g.starts.clone();
         g.order = vec![0u32; count];
+        let mut k = 0;
         for_each_set(&kept, |i| {
-            let c = cells.at(x[i], y[i]);
+            let c = cell_of[k] as usize;
+            k += 1;
             g.order[fill[c] as usize] = i as u32;
             fill[c] += 1;
         });
