@@ -3,8 +3,8 @@
 //! (two passes, no comparison sort): 4 bytes per point for the sorted indices plus 4
 //! bytes per cell, with the cell grown (never below the requested size) until there are at
 //! most half as many cells as points — about 6 bytes per point in all, and a bit per point
-//! while it is built. A query visits only the cells the disc touches, never the whole
-//! cloud.
+//! and 4 bytes per indexed point (its cell) while it is built. A query visits only the
+//! cells the disc touches, never the whole cloud.
 
 /// Point indices bucketed by a square XY cell over the points' bounding box.
 pub struct PointGrid {
