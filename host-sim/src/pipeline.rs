@@ -465,13 +465,7 @@ pub fn extract_file_with(
         candidates: &r.kernel.candidates,
         trajectory: &r.trajectory,
     };
-    let mut edges = bend::extract_edges(&input, &cfg.bend);
-    crate::curb::annotate(
-        &input,
-        &bend::route::Route::new(&r.trajectory),
-        edges.iter_mut(),
-    );
-    let mut edges = crate::curb::finish(edges);
+    let mut edges = crate::curb::finish(extract_and_annotate(&input, &cfg.bend));
     for e in &mut edges {
         e.method
             .get_or_insert_with(|| Method::Bend.as_str().to_string());
@@ -499,6 +493,22 @@ pub fn extract_file_with(
         edges,
         summary,
     })
+}
+
+/// The bend method's edges of the whole input, annotated with their curbs: one route and
+/// one point index for the tracker and the annotation, as each window of the stream has.
+fn extract_and_annotate(
+    input: &BendInput,
+    params: &bend::BendParams,
+) -> Vec<crate::model::EdgeLine> {
+    let route = bend::route::Route::new(input.trajectory);
+    let grid = bend::point_grid(input, params);
+    let mut edges: Vec<_> = bend::extract_edges_on_grid(input, &grid, &route, params)
+        .into_iter()
+        .map(|(e, _)| e)
+        .collect();
+    crate::curb::annotate(input, &grid, &route, edges.iter_mut());
+    edges
 }
 
 /// The second method (Qiu et al.) on the same points: it works on the world points and the
@@ -608,13 +618,7 @@ pub fn extract_columns(
                 candidates: &kernel.candidates,
                 trajectory,
             };
-            let mut edges = bend::extract_edges(&input, &cfg.bend);
-            crate::curb::annotate(
-                &input,
-                &bend::route::Route::new(trajectory),
-                edges.iter_mut(),
-            );
-            crate::curb::finish(edges)
+            crate::curb::finish(extract_and_annotate(&input, &cfg.bend))
         }
     };
     for e in &mut edges {

@@ -103,13 +103,29 @@ pub fn extract_edges_on_route(
     route: &route::Route,
     params: &BendParams,
 ) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
+    extract_edges_on_grid(input, &point_grid(input, params), route, params)
+}
+
+/// The one index over every processed point that the tracker and the curb annotation
+/// share: tracking reads the kept points, the vehicle filter, the height step and the
+/// cross-sections of [`crate::curb::annotate`] read all. Cells of the search radius
+/// (5 cm to 1 m).
+pub fn point_grid(input: &BendInput, params: &BendParams) -> grid::PointGrid {
     let input = input.truncated();
-    // One index over every processed point: tracking reads the kept ones, the vehicle
-    // filter and the height step read all.
     let cell_m = params.search_radius_m.clamp(0.05, 1.0);
-    let grid = grid::PointGrid::build(input.x, input.y, cell_m, |i| input.status[i].is_some());
+    grid::PointGrid::build(input.x, input.y, cell_m, |i| input.status[i].is_some())
+}
+
+/// [`extract_edges_on_route`] on `grid`, the [`point_grid`] of `input`.
+pub fn extract_edges_on_grid(
+    input: &BendInput,
+    grid: &grid::PointGrid,
+    route: &route::Route,
+    params: &BendParams,
+) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
+    let input = input.truncated();
     let mut seeds = seed::seed_points(&input, route, params);
-    let from_profiles = seed::profile_seeds(&input, &grid, route, params);
+    let from_profiles = seed::profile_seeds(&input, grid, route, params);
     seeds.extend(from_profiles);
     // Best-fitting seeds first: the first track along a curb claims it, later seeds on the
     // same curb start nothing.
@@ -120,9 +136,9 @@ pub fn extract_edges_on_route(
             .then(a.interval.cmp(&b.interval))
             .then(a.point.cmp(&b.point))
     });
-    let tracks = track::track_edges(&input, &grid, &seeds, params);
+    let tracks = track::track_edges(&input, grid, &seeds, params);
     let tracks = postfilter::remove_short(&input, tracks, params);
-    let tracks = postfilter::remove_under_objects(&input, &grid, tracks, params);
+    let tracks = postfilter::remove_under_objects(&input, grid, tracks, params);
     let tracks = if params.roadway_filter {
         postfilter::remove_outside_roadway(&input, route, tracks)
     } else {
@@ -135,8 +151,8 @@ pub fn extract_edges_on_route(
         .max()
         .map_or(0, |m| m.saturating_add(1))
         .max(input.x.len() as u32);
-    let tracks = bridge::bridge_tracks(&input, &grid, tracks, next_id, params);
-    postfilter::to_edge_lines_with_steps(&input, &grid, route, &tracks, params)
+    let tracks = bridge::bridge_tracks(&input, grid, tracks, next_id, params);
+    postfilter::to_edge_lines_with_steps(&input, grid, route, &tracks, params)
 }
 
 #[cfg(test)]

@@ -38,9 +38,12 @@ fn usable(s: Option<PointStatus>) -> bool {
 }
 
 /// Adds the top of curb, the height per vertex and the class per vertex to every edge of
-/// `edges` that carries a [`CurbDetail`] (the bend method's), from `input`'s points.
+/// `edges` that carries a [`CurbDetail`] (the bend method's), from `input`'s points as
+/// `grid` indexes them ([`crate::bend::point_grid`], the tracker's own index: every point
+/// the core processed).
 pub fn annotate<'e>(
     input: &BendInput,
+    grid: &PointGrid,
     route: &Route,
     edges: impl IntoIterator<Item = &'e mut EdgeLine>,
 ) {
@@ -51,27 +54,8 @@ pub fn annotate<'e>(
     if edges.is_empty() {
         return;
     }
-    // Only the points near an edge are indexed.
-    let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
-    for e in &edges {
-        for p in &e.points {
-            x0 = x0.min(p[0]);
-            y0 = y0.min(p[1]);
-            x1 = x1.max(p[0]);
-            y1 = y1.max(p[1]);
-        }
-    }
-    let r = REACH_M.hypot(STRIP_HALF_M) + 0.05;
-    let n = input.x.len().min(input.y.len()).min(input.status.len());
-    let grid = PointGrid::build(&input.x[..n], &input.y[..n], 0.25, |i| {
-        usable(input.status[i])
-            && input.x[i] >= x0 - r
-            && input.x[i] <= x1 + r
-            && input.y[i] >= y0 - r
-            && input.y[i] <= y1 + r
-    });
     for e in edges.iter_mut() {
-        sections_along(input, &grid, route, e);
+        sections_along(input, grid, route, e);
     }
     class::classify(route, &mut edges);
 }
@@ -129,6 +113,9 @@ fn sections_along(input: &BendInput, grid: &PointGrid, route: &Route, e: &mut Ed
             p[1],
             REACH_M.hypot(STRIP_HALF_M),
             |i| {
+                if !usable(input.status[i]) {
+                    return;
+                }
                 let dz = input.z[i] - p[2];
                 if dz.abs() > BAND_M {
                     return;

@@ -160,6 +160,15 @@ pub struct RingStage<'a> {
     carry: PointBatch,
     /// The vehicle-frame coordinates of the first carried points (computed once).
     body: Vec<Body>,
+    /// Carried points already sorted into runs (each point is looked at once).
+    scanned: usize,
+    /// Each ring's open run, by ring number.
+    open: Vec<Option<Run>>,
+    /// Runs ended but not yet sent: they reach past the cut of an earlier batch.
+    ended: Vec<Run>,
+    /// Per scanned point: 1 too near, 2 too far to the side; counted once the point
+    /// leaves the carry.
+    left_out: Vec<u8>,
     next_base: u64,
     lines: u32,
     pipe: Box<ArcPipeline>,
@@ -185,6 +194,10 @@ impl<'a> RingStage<'a> {
             sensor: None,
             carry: PointBatch::default(),
             body: Vec::new(),
+            scanned: 0,
+            open: (0..256).map(|_| None).collect(),
+            ended: Vec::new(),
+            left_out: Vec::new(),
             next_base: 0,
             lines: 0,
             pipe: Box::new(ArcPipeline::new()),
@@ -264,27 +277,26 @@ impl<'a> RingStage<'a> {
                 })
             }));
         }
-        let mut open: Vec<Option<Run>> = (0..256).map(|_| None).collect();
-        let mut closed: Vec<Run> = Vec::new();
+        // Runs carry over between batches: only the points new since the last batch are
+        // sorted into them.
         let (min2, lat) = (self.arc.min_range_m.powi(2), self.arc.max_lateral_m);
-        // 1: too near, 2: too far to the side; counted once the point leaves the carry.
-        let mut left_out = vec![0u8; n];
-        for (i, &p) in body.iter().enumerate() {
+        self.left_out.resize(n, 0);
+        for (i, &p) in body.iter().enumerate().skip(self.scanned) {
             if p.x.is_nan() {
                 continue;
             }
             if p.x * p.x + p.y * p.y < min2 {
-                left_out[i] = 1;
+                self.left_out[i] = 1;
                 continue;
             }
             if p.y.abs() > lat {
-                left_out[i] = 2;
+                self.left_out[i] = 2;
                 continue;
             }
             let ring = c.channel[i];
             self.rings_seen[usize::from(ring >> 6)] |= 1 << (ring & 63);
             let front = p.x >= 0.0;
-            let slot = &mut open[usize::from(ring)];
+            let slot = &mut self.open[usize::from(ring)];
             match slot {
                 Some(r) if r.front == front && c.t[i] - r.last_t <= gap => {
                     r.points.push(i as u32);
@@ -292,7 +304,7 @@ impl<'a> RingStage<'a> {
                 }
                 _ => {
                     if let Some(r) = slot.take() {
-                        closed.push(r);
+                        self.ended.push(r);
                     }
                     *slot = Some(Run {
                         front,
@@ -302,19 +314,29 @@ impl<'a> RingStage<'a> {
                 }
             }
         }
+        self.scanned = n;
+        // A run silent for more than the gap has ended: the ring's next point (later in
+        // time) starts a new one.
         let t_end = c.t.last().copied().unwrap_or(f64::NEG_INFINITY);
-        let mut held: Vec<Run> = Vec::new();
-        for r in open.into_iter().flatten() {
-            if last || t_end - r.last_t > gap {
-                closed.push(r);
-            } else {
-                held.push(r);
+        for slot in self.open.iter_mut() {
+            if slot
+                .as_ref()
+                .is_some_and(|r| last || t_end - r.last_t > gap)
+            {
+                self.ended.extend(slot.take());
             }
         }
-        // The cut: before every open run, and before every closed run that reaches it.
-        let mut cut = held.iter().map(|r| r.points[0] as usize).min().unwrap_or(n);
+        // The cut: before every open run, and before every ended run that reaches it.
+        let mut cut = self
+            .open
+            .iter()
+            .flatten()
+            .map(|r| r.points[0] as usize)
+            .min()
+            .unwrap_or(n);
         loop {
-            let c2 = closed
+            let c2 = self
+                .ended
                 .iter()
                 .filter(|r| *r.points.last().unwrap_or(&0) as usize >= cut)
                 .map(|r| r.points[0] as usize)
@@ -330,8 +352,19 @@ impl<'a> RingStage<'a> {
             self.body = body;
             return Ok(None);
         }
-        closed.retain(|r| (*r.points.last().unwrap_or(&0) as usize) < cut);
+        // Ended runs before the cut go now; the rest wait, renumbered from the cut.
+        let (mut closed, mut wait): (Vec<Run>, Vec<Run>) = std::mem::take(&mut self.ended)
+            .into_iter()
+            .partition(|r| (*r.points.last().unwrap_or(&0) as usize) < cut);
+        let shift = cut as u32;
+        for r in wait.iter_mut().chain(self.open.iter_mut().flatten()) {
+            for i in r.points.iter_mut() {
+                *i -= shift;
+            }
+        }
+        self.ended = std::mem::take(&mut wait);
         closed.sort_by_key(|r| r.points[0]);
+        let left_out = std::mem::take(&mut self.left_out);
         self.arcs.points_near += left_out[..cut].iter().filter(|&&f| f == 1).count() as u64;
         self.arcs.points_lateral += left_out[..cut].iter().filter(|&&f| f == 2).count() as u64;
         let mut arcs: Vec<Vec<u32>> = Vec::with_capacity(closed.len());
@@ -344,6 +377,9 @@ impl<'a> RingStage<'a> {
         let out = self.run_core(&body, &arcs, &sensor, &kernel, cut)?;
         body.drain(..cut);
         self.body = body;
+        self.left_out = left_out;
+        self.left_out.drain(..cut);
+        self.scanned -= cut;
         Ok(Some(out))
     }
 

@@ -333,8 +333,10 @@ impl<'a> SectionWindow<'a> {
             candidates: &cands,
             trajectory: self.traj,
         };
-        let mut edges = bend::extract_edges_on_route(&input, &self.route, &self.bend);
-        curb::annotate(&input, &self.route, edges.iter_mut().map(|(e, _)| e));
+        // One index for the tracker and the curb annotation.
+        let grid = bend::point_grid(&input, &self.bend);
+        let mut edges = bend::extract_edges_on_grid(&input, &grid, &self.route, &self.bend);
+        curb::annotate(&input, &grid, &self.route, edges.iter_mut().map(|(e, _)| e));
         edges
     }
 }
