@@ -244,7 +244,7 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
 }
 
 /// The run rules on closed edges ([`grow_cuts`], [`flush_runs`], then the smoothing of
-/// [`smoothed_runs`] to stretches of at least [`MIN_RUN_M`]), leaving each vertex's class
+/// [`category_runs`] to stretches of at least [`MIN_RUN_M`]), leaving each vertex's class
 /// the class of its stretch. Edges that continue one another (the end of one within
 /// [`END_JOIN_M`] of the start of the next, on the same side) are one line for these rules:
 /// the tracker often ends a track where the curb drops and starts the next one there, so a
