@@ -371,7 +371,7 @@ pub fn to_edge_lines_with_steps(
                 }
             })
             .collect();
-        let runs = category_runs(&xy, &cats, params.min_category_run_m);
+        let runs = category_runs(&raw, &cats, params.min_category_run_m);
         for (a, b, cat) in runs {
             let mut st: Vec<f64> = steps[a..=b].iter().flatten().copied().collect();
             out.push((
@@ -457,24 +457,26 @@ fn smooth(p: &[[f64; 3]], k: usize) -> Vec<[f64; 3]> {
 }
 
 /// Runs `(first, last, category)` of equal category over the vertices (consecutive runs
-/// share their boundary vertex); runs shorter than `min_run_m` are absorbed by the
-/// neighbour before them (or after, for the first run).
-fn category_runs(
-    xy: &[[f64; 2]],
+/// share their boundary vertex); runs shorter than `min_run_m` (horizontal arc length) are
+/// absorbed by the neighbour before them (or after, for the first run), shortest first.
+/// Vertices past the shorter of the two slices are ignored. The one rule for cutting an
+/// edge into category runs: the tracker's first classes here, the curb's settled classes
+/// in `curb::class`.
+pub fn category_runs(
+    pts: &[[f64; 3]],
     cats: &[Category],
     min_run_m: f64,
 ) -> Vec<(usize, usize, Category)> {
-    if xy.is_empty() {
+    let m = pts.len().min(cats.len());
+    if m == 0 {
         return Vec::new();
     }
-    let len = |a: usize, b: usize| -> f64 {
-        xy[a..=b]
-            .windows(2)
-            .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
-            .sum()
-    };
+    let mut s = vec![0.0; m];
+    for k in 1..m {
+        s[k] = s[k - 1] + (pts[k][0] - pts[k - 1][0]).hypot(pts[k][1] - pts[k - 1][1]);
+    }
     let mut runs: Vec<(usize, usize, Category)> = Vec::new();
-    for (k, &c) in cats.iter().enumerate() {
+    for (k, &c) in cats[..m].iter().enumerate() {
         match runs.last_mut() {
             Some(r) if r.2 == c => r.1 = k,
             Some(r) => {
@@ -484,19 +486,17 @@ fn category_runs(
             None => runs.push((k, k, c)),
         }
     }
-    // A run holding only the boundary vertex of a final change: fold it back.
+    // A run holding only the boundary vertex of a final change: fold it back (the run
+    // before already ends on that vertex).
     if runs.len() > 1 && runs.last().is_some_and(|r| r.0 == r.1) {
         runs.pop();
     }
     // Absorb short runs, shortest first, until every run is long enough or one is left.
-    loop {
-        if runs.len() <= 1 {
-            break;
-        }
+    while runs.len() > 1 {
         let Some((k, _)) = runs
             .iter()
             .enumerate()
-            .map(|(k, r)| (k, len(r.0, r.1)))
+            .map(|(k, r)| (k, s[r.1] - s[r.0]))
             .filter(|&(_, l)| l < min_run_m)
             .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
         else {
@@ -513,7 +513,7 @@ fn category_runs(
         let mut merged: Vec<(usize, usize, Category)> = Vec::new();
         for r in runs.drain(..) {
             match merged.last_mut() {
-                Some(m) if m.2 == r.2 => m.1 = r.1,
+                Some(q) if q.2 == r.2 => q.1 = r.1,
                 _ => merged.push(r),
             }
         }
@@ -552,7 +552,7 @@ mod tests {
     #[test]
     fn short_category_runs_are_absorbed() {
         // 21 vertices 0.1 m apart: curb, 3 vertices (0.2–0.3 m) of curb cut, curb.
-        let xy: Vec<[f64; 2]> = (0..21).map(|k| [k as f64 * 0.1, 0.0]).collect();
+        let xy: Vec<[f64; 3]> = (0..21).map(|k| [k as f64 * 0.1, 0.0, 0.0]).collect();
         let mut cats = vec![Category::Curb; 21];
         for c in &mut cats[8..11] {
             *c = Category::CurbCut;

@@ -4,6 +4,7 @@
 //! `flush` for a low run longer than any curb cut.
 
 use super::tangent;
+use crate::bend::postfilter::category_runs;
 use crate::bend::route::Route;
 use crate::model::{Category, CurbDetail, EdgeLine, Side};
 
@@ -243,7 +244,7 @@ pub fn classify(route: &Route, edges: &mut [&mut EdgeLine]) {
 }
 
 /// The run rules on closed edges ([`grow_cuts`], [`flush_runs`], then the smoothing of
-/// [`smoothed_runs`] to stretches of at least [`MIN_RUN_M`]), leaving each vertex's class
+/// [`category_runs`] to stretches of at least [`MIN_RUN_M`]), leaving each vertex's class
 /// the class of its stretch. Edges that continue one another (the end of one within
 /// [`END_JOIN_M`] of the start of the next, on the same side) are one line for these rules:
 /// the tracker often ends a track where the curb drops and starts the next one there, so a
@@ -311,7 +312,7 @@ pub fn settle_runs(edges: &mut [EdgeLine]) {
         }
         grow_cuts(&pts, &mut d);
         flush_runs(&pts, &mut d);
-        for (a, b, cat) in smoothed_runs(&pts, &d.class, MIN_RUN_M) {
+        for (a, b, cat) in category_runs(&pts, &d.class, MIN_RUN_M) {
             d.class[a..=b].fill(cat);
         }
         let mut at = 0;
@@ -459,65 +460,6 @@ pub fn flush_runs(pts: &[[f64; 3]], d: &mut CurbDetail) {
     }
 }
 
-/// Runs `(first, last, class)` of equal class over the vertices (consecutive runs share
-/// their boundary vertex); runs shorter than `min_run_m` join the neighbour before them
-/// (or after, for the first run), shortest first.
-pub fn smoothed_runs(
-    pts: &[[f64; 3]],
-    class: &[Category],
-    min_run_m: f64,
-) -> Vec<(usize, usize, Category)> {
-    let m = pts.len().min(class.len());
-    if m == 0 {
-        return Vec::new();
-    }
-    let s = arc(pts);
-    let mut runs: Vec<(usize, usize, Category)> = Vec::new();
-    for (k, &c) in class[..m].iter().enumerate() {
-        match runs.last_mut() {
-            Some(r) if r.2 == c => r.1 = k,
-            Some(r) => {
-                r.1 = k;
-                runs.push((k, k, c));
-            }
-            None => runs.push((k, k, c)),
-        }
-    }
-    if runs.len() > 1 && runs.last().is_some_and(|r| r.0 == r.1) {
-        runs.pop();
-        if let Some(r) = runs.last_mut() {
-            r.1 = m - 1;
-        }
-    }
-    while runs.len() > 1 {
-        let Some((k, _)) = runs
-            .iter()
-            .enumerate()
-            .map(|(k, r)| (k, s[r.1] - s[r.0]))
-            .filter(|&(_, l)| l < min_run_m)
-            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
-        else {
-            break;
-        };
-        if k == 0 {
-            runs[1].0 = runs[0].0;
-            runs.remove(0);
-        } else {
-            runs[k - 1].1 = runs[k].1;
-            runs.remove(k);
-        }
-        let mut merged: Vec<(usize, usize, Category)> = Vec::new();
-        for r in runs.drain(..) {
-            match merged.last_mut() {
-                Some(q) if q.2 == r.2 => q.1 = r.1,
-                _ => merged.push(r),
-            }
-        }
-        runs = merged;
-    }
-    runs
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -545,7 +487,7 @@ mod tests {
         let mut c = vec![Category::Curb; 101];
         c[40..43].fill(Category::CurbCut); // 0.2 m: absorbed
         c[60..95].fill(Category::CurbCut); // 3.4 m: kept
-        let runs = smoothed_runs(&p, &c, 1.0);
+        let runs = category_runs(&p, &c, 1.0);
         // The last 0.5 m of curb is too short for a stretch of its own.
         assert_eq!(
             runs,

@@ -16,6 +16,7 @@ pub mod class;
 pub mod profile;
 
 use crate::bend::grid::PointGrid;
+use crate::bend::postfilter::category_runs;
 use crate::bend::route::Route;
 use crate::bend::BendInput;
 use crate::model::{Category, EdgeLine, BRIDGED_MIN_M};
@@ -225,7 +226,7 @@ pub fn finish(mut edges: Vec<EdgeLine>) -> Vec<EdgeLine> {
         };
         // The classes are settled: every run here is a stretch (or the part of one that
         // lies on this edge).
-        let class = class::smoothed_runs(&e.points, &d.class, 0.0);
+        let class = category_runs(&e.points, &d.class, 0.0);
         let measured = d.measured.clone();
         for (a, b, cat) in class {
             for (ra, rb, bridged) in bridged_runs(&e.points[a..=b], &measured[a..=b]) {
