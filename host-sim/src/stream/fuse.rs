@@ -1,4 +1,5 @@
-//! Fusion: the closed edges of several channels (scanners) made one edge per curb.
+//! Fusion: the closed edges of several channels (scanners) and passes made one edge per
+//! curb.
 //!
 //! Fusion is late: each scanner's scanlines run through a core and a tracker of their own
 //! (as each scanner's controller would), and the closed edges are fused here. Early
@@ -78,11 +79,22 @@ struct Run {
     observed: bool,
 }
 
-/// Fuses the edges of several channels, `(channel key, its closed edges)`. Every vertex
-/// of the result records the channel whose tracker placed it (`CurbDetail::scanner`).
-pub fn fuse(channels: Vec<(u16, Vec<EdgeLine>)>, p: &FuseParams) -> Vec<EdgeLine> {
+/// A source of edges: a scanner (channel key) in a pass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Source {
+    /// The scanner's channel key.
+    pub scanner: u16,
+    /// The pass (`stream::passes`), 0 for the first.
+    pub pass: u16,
+}
+
+/// Fuses the edges of several sources, each `(source, its closed edges)`, the edges of
+/// later passes already turned to the first pass's direction. Every vertex of the result
+/// records the scanner and the pass whose tracker placed it (`CurbDetail::scanner`,
+/// `CurbDetail::pass`).
+pub fn fuse(channels: Vec<(Source, Vec<EdgeLine>)>, p: &FuseParams) -> Vec<EdgeLine> {
     let mut runs = Vec::new();
-    for (key, edges) in channels {
+    for (src, edges) in channels {
         for mut e in edges {
             let n = e.points.len();
             if n < 2 {
@@ -90,7 +102,8 @@ pub fn fuse(channels: Vec<(u16, Vec<EdgeLine>)>, p: &FuseParams) -> Vec<EdgeLine
             }
             let measured = match e.detail.as_mut() {
                 Some(d) => {
-                    d.scanner = vec![key; n];
+                    d.scanner = vec![src.scanner; n];
+                    d.pass = vec![src.pass; n];
                     d.measured.clone()
                 }
                 None => vec![true; n],
@@ -318,6 +331,14 @@ mod tests {
     use super::*;
     use crate::model::{CurbDetail, Side};
 
+    /// Scanner `k` of the first pass.
+    fn ch(k: u16) -> Source {
+        Source {
+            scanner: k,
+            pass: 0,
+        }
+    }
+
     /// An edge along y = `y` from x0 to x1 with vertices every 0.1 m; `measured` says
     /// which x ranges rest on candidates (all when empty).
     fn edge(x0: f64, x1: f64, y: f64, unmeasured: &[(f64, f64)]) -> EdgeLine {
@@ -365,7 +386,7 @@ mod tests {
         // 8–17 m, 0.04 m off.
         let s0 = vec![edge(0.0, 10.0, 0.0, &[]), edge(15.0, 30.0, 0.0, &[])];
         let s1 = vec![edge(8.0, 17.0, 0.04, &[])];
-        let out = fuse(vec![(0, s0), (1, s1)], &FuseParams::default());
+        let out = fuse(vec![(ch(0), s0), (ch(1), s1)], &FuseParams::default());
         assert_eq!(out.len(), 1, "{out:?}");
         let e = &out[0];
         assert!((e.length_m() - 30.0).abs() < 0.3, "{}", e.length_m());
@@ -389,7 +410,7 @@ mod tests {
         // only as short pieces.
         let s0 = vec![edge(0.0, 30.0, 0.0, &[(8.0, 16.0)])];
         let s1 = vec![edge(7.0, 12.0, -0.05, &[]), edge(12.2, 17.0, -0.05, &[])];
-        let out = fuse(vec![(0, s0), (1, s1)], &FuseParams::default());
+        let out = fuse(vec![(ch(0), s0), (ch(1), s1)], &FuseParams::default());
         assert_eq!(out.len(), 1, "{out:?}");
         let d = out[0].detail.as_ref().unwrap();
         // Between 8 and 16 m the vertices are scanner 1's observed ones, except the 0.2 m
@@ -414,14 +435,14 @@ mod tests {
             *q = [5.0, q[0], 0.0];
         }
         let b = vec![edge(0.0, 10.0, 2.0, &[]), across];
-        let out = fuse(vec![(0, a), (1, b)], &FuseParams::default());
+        let out = fuse(vec![(ch(0), a), (ch(1), b)], &FuseParams::default());
         let total: f64 = out.iter().map(|e| e.length_m()).sum();
         assert!((total - 30.0).abs() < 0.5, "{total}");
         // The other side is never a duplicate.
         let mut r = edge(0.0, 10.0, 0.0, &[]);
         r.side = Side::Right;
         let out = fuse(
-            vec![(0, vec![edge(0.0, 10.0, 0.0, &[])]), (1, vec![r])],
+            vec![(ch(0), vec![edge(0.0, 10.0, 0.0, &[])]), (ch(1), vec![r])],
             &FuseParams::default(),
         );
         assert_eq!(out.len(), 2);
@@ -432,7 +453,7 @@ mod tests {
         // Scanner 1 drops out from 12 m on; scanner 0 has everything.
         let s0 = vec![edge(0.0, 40.0, 0.0, &[])];
         let s1 = vec![edge(0.0, 12.0, 0.02, &[])];
-        let out = fuse(vec![(0, s0), (1, s1)], &FuseParams::default());
+        let out = fuse(vec![(ch(0), s0), (ch(1), s1)], &FuseParams::default());
         assert_eq!(out.len(), 1);
         assert!((out[0].length_m() - 40.0).abs() < 1e-6);
         assert_eq!(out[0].detail.as_ref().unwrap().scanners(), vec![0]);
