@@ -10,7 +10,8 @@
 //!
 //! The rule: every edge is cut into its observed runs (vertices resting on candidates) and
 //! its bridged runs (placed by the tracker over at least `model::BRIDGED_MIN_M`). Observed runs
-//! come first, longest first, then bridged runs, longest first. A run's vertex is a
+//! come first, those of the first pass before later passes', longest first, then bridged
+//! runs in the same order. A run's vertex is a
 //! duplicate when an already kept line of the same side passes within [`FuseParams::near_m`]
 //! of it in a direction within [`FuseParams::max_angle_deg`]; the vertices that are not
 //! duplicates are kept, in runs, each with the duplicate vertex beside it so it meets the
@@ -77,6 +78,7 @@ pub fn add_summaries(mut a: ExtractResult, b: &ExtractResult) -> ExtractResult {
 struct Run {
     line: EdgeLine,
     observed: bool,
+    pass: u16,
 }
 
 /// A source of edges: a scanner (channel key) in a pass.
@@ -113,15 +115,18 @@ pub fn fuse(channels: Vec<(Source, Vec<EdgeLine>)>, p: &FuseParams) -> Vec<EdgeL
                     runs.push(Run {
                         line: e.sub(a, b + 1),
                         observed: !bridged,
+                        pass: src.pass,
                     });
                 }
             }
         }
     }
-    // Observed before bridged, longer before shorter; ties in input order.
+    // Observed before bridged, the first pass before later ones (its geometry is the
+    // frame the others were shifted onto), longer before shorter; ties in input order.
     runs.sort_by(|a, b| {
         b.observed
             .cmp(&a.observed)
+            .then(a.pass.cmp(&b.pass))
             .then(b.line.length_m().total_cmp(&a.line.length_m()))
     });
     let mut kept: Vec<EdgeLine> = Vec::new();
@@ -457,5 +462,66 @@ mod tests {
         assert_eq!(out.len(), 1);
         assert!((out[0].length_m() - 40.0).abs() < 1e-6);
         assert_eq!(out[0].detail.as_ref().unwrap().scanners(), vec![0]);
+    }
+
+    #[test]
+    fn two_passes_in_opposite_directions_give_one_edge_in_the_first_pass_frame() {
+        // Pass 0 drives east and sees the left curb at y = 0 over 0–12 m and 18–40 m (a
+        // parked car hides 12–18 m). Pass 1 drives back west, 0.1 m off (GNSS drift): it
+        // sees the same curb on its right over 5–30 m.
+        let p0 = vec![edge(0.0, 12.0, 0.0, &[]), edge(18.0, 40.0, 0.0, &[])];
+        let mut back = edge(5.0, 30.0, 0.1, &[]).reversed();
+        back.side = Side::Right;
+        // As extract does: turned to pass 0's direction, shifted onto its edges.
+        let mut p1 = vec![back.reversed()];
+        assert_eq!(p1[0].side, Side::Left);
+        let t = crate::stream::passes::shift_onto(&p0, &p1).expect("a shift");
+        assert!((t[1] + 0.1).abs() < 0.01 && t[0].abs() < 0.01, "{t:?}");
+        crate::stream::passes::shifted(&mut p1, t);
+        let pass = |k: u16| Source {
+            scanner: 0,
+            pass: k,
+        };
+        let out = fuse(vec![(pass(0), p0), (pass(1), p1)], &FuseParams::default());
+        assert_eq!(out.len(), 1, "{out:?}");
+        let e = &out[0];
+        assert!((e.length_m() - 40.0).abs() < 0.3, "{}", e.length_m());
+        assert!(
+            e.points.windows(2).all(|w| w[1][0] > w[0][0]),
+            "pass 0's direction"
+        );
+        assert!(e.points.iter().all(|p| p[1].abs() < 0.02), "on the curb");
+        let d = e.detail.as_ref().unwrap();
+        assert_eq!(d.passes(), vec![0, 1]);
+        // Pass 1 fills the 6 m pass 0 missed, nothing more.
+        let from1: f64 = e
+            .points
+            .windows(2)
+            .zip(d.pass.windows(2))
+            .filter(|(_, s)| s[0] == 1 && s[1] == 1)
+            .map(|(w, _)| w[1][0] - w[0][0])
+            .sum();
+        assert!((5.0..=6.5).contains(&from1), "{from1}");
+        assert!(doubled_m(&out, 0.3) < 0.5);
+    }
+
+    #[test]
+    fn two_overlapping_sections_give_one_edge() {
+        // Two sections of a campaign overlap over 20–30 m of one curb.
+        let a = vec![edge(0.0, 30.0, 0.0, &[])];
+        let b = vec![edge(20.0, 50.0, 0.01, &[])];
+        let sec = |k: u16| Source {
+            scanner: 0,
+            pass: k,
+        };
+        let out = fuse(vec![(sec(0), a), (sec(1), b)], &FuseParams::default());
+        assert_eq!(out.len(), 1, "{out:?}");
+        assert!(
+            (out[0].length_m() - 50.0).abs() < 0.1,
+            "{}",
+            out[0].length_m()
+        );
+        assert!(doubled_m(&out, 0.3) < 0.5);
+        assert_eq!(out[0].detail.as_ref().unwrap().passes(), vec![0, 1]);
     }
 }

@@ -149,9 +149,10 @@ pub fn passes(traj: &Trajectory) -> Vec<Trajectory> {
     out
 }
 
-/// Whether pass `other` drives the other way from `first` where it passes `xy`: their
-/// directions of travel at their stations nearest to `xy`, when `first` has one within
-/// [`BACK_M`].
+/// Whether pass `other` drives the other way from `first` where it saw a line: the
+/// direction of travel at `other`'s station nearest to the line against `first`'s at its
+/// station nearest to that one, when `first` came within [`BACK_M`] of it (a side
+/// street's curb lies far from both routes; the vehicle's places decide).
 pub struct Orientation {
     first: Vec<Station>,
     other: Vec<Station>,
@@ -166,16 +167,19 @@ impl Orientation {
         }
     }
 
-    /// Whether `other` heads against `first` near `xy` (false where `first` did not
-    /// come within [`BACK_M`]).
+    /// Whether `other` heads against `first` where it saw `xy` (false where `first` did
+    /// not come within [`BACK_M`] of `other` there).
     pub fn reversed_at(&self, xy: [f64; 2]) -> bool {
-        let near = |st: &[Station]| {
+        let near = |st: &[Station], xy: [f64; 2]| {
             st.iter()
-                .map(|p| ((p.xy[0] - xy[0]).hypot(p.xy[1] - xy[1]), p.dir))
+                .map(|p| ((p.xy[0] - xy[0]).hypot(p.xy[1] - xy[1]), *p))
                 .min_by(|a, b| a.0.total_cmp(&b.0))
         };
-        match (near(&self.first), near(&self.other)) {
-            (Some((d, a)), Some((_, b))) if d <= BACK_M => a[0] * b[0] + a[1] * b[1] < 0.0,
+        let Some((_, b)) = near(&self.other, xy) else {
+            return false;
+        };
+        match near(&self.first, b.xy) {
+            Some((d, a)) if d <= BACK_M => a.dir[0] * b.dir[0] + a.dir[1] * b.dir[1] < 0.0,
             _ => false,
         }
     }
@@ -335,7 +339,12 @@ mod tests {
         assert!(b.iter().all(|s| s.y >= STATION_M), "{:?}", b.first());
         let o = Orientation::new(&p[0], &p[1]);
         assert!(o.reversed_at([100.0, 1.7]));
-        assert!(!o.reversed_at([100.0, 40.0]), "far from the first pass");
+        // A side street's curb 40 m off: seen from where both passes drove.
+        assert!(o.reversed_at([100.0, 40.0]));
+        // A pass on another street is not turned.
+        let elsewhere = drive(&[[0.0, 50.0], [200.0, 50.0]], 99, 0.0);
+        let o = Orientation::new(&p[0], &elsewhere);
+        assert!(!o.reversed_at([100.0, 48.0]));
     }
 
     #[test]
