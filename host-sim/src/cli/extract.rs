@@ -70,7 +70,7 @@ pub struct Args {
     #[arg(long)]
     pub scanner: Option<u16>,
     /// Pass: only the Nth pass (from 0) of a trajectory that drives the same road again.
-    /// Without it every pass is extracted and the passes fused (docs/spec.md, Passes).
+    /// Without it every pass is extracted and the passes fused (docs/architecture.md, "Several passes").
     #[arg(long)]
     pub pass: Option<u16>,
     /// TOML file with the scanners' mounts (a `[scanners]` table, as `simulate --scanners 2`
