@@ -161,6 +161,9 @@ pub struct CurbDetail {
     /// The scanner (channel key) whose tracker placed each vertex, where the edges of
     /// several scanners were fused (`stream::fuse`); empty otherwise.
     pub scanner: Vec<u16>,
+    /// The pass (`stream::passes`) whose tracker placed each vertex, where edges of
+    /// several scanners or passes were fused; empty otherwise.
+    pub pass: Vec<u16>,
 }
 
 /// Shortest run of bridged toe vertices that makes a stretch of its own, metres; shorter
@@ -179,6 +182,7 @@ impl CurbDetail {
             bridged: false,
             support_per_m: 0.0,
             scanner: Vec::new(),
+            pass: Vec::new(),
         }
     }
 
@@ -197,6 +201,7 @@ impl CurbDetail {
                 .get(a..b)
                 .map(<[u16]>::to_vec)
                 .unwrap_or_default(),
+            pass: self.pass.get(a..b).map(<[u16]>::to_vec).unwrap_or_default(),
         }
     }
 
@@ -207,17 +212,46 @@ impl CurbDetail {
         self.measured.extend_from_slice(&other.measured);
         self.top_measured.extend_from_slice(&other.top_measured);
         self.class.extend_from_slice(&other.class);
-        // Per-vertex scanners only where both sides have them.
-        if !self.scanner.is_empty() && !other.scanner.is_empty() {
-            self.scanner.extend_from_slice(&other.scanner);
-        } else {
-            self.scanner.clear();
+        // Per-vertex scanners and passes only where both sides have them.
+        for (a, b) in [
+            (&mut self.scanner, &other.scanner),
+            (&mut self.pass, &other.pass),
+        ] {
+            if !a.is_empty() && !b.is_empty() {
+                a.extend_from_slice(b);
+            } else {
+                a.clear();
+            }
+        }
+    }
+
+    /// The detail of the vertices in reverse order.
+    pub fn reversed(&self) -> Self {
+        let rev = |v: &[bool]| v.iter().rev().copied().collect::<Vec<_>>();
+        Self {
+            top: self.top.iter().rev().copied().collect(),
+            height_m: self.height_m.iter().rev().copied().collect(),
+            measured: rev(&self.measured),
+            top_measured: rev(&self.top_measured),
+            class: self.class.iter().rev().copied().collect(),
+            bridged: self.bridged,
+            support_per_m: self.support_per_m,
+            scanner: self.scanner.iter().rev().copied().collect(),
+            pass: self.pass.iter().rev().copied().collect(),
         }
     }
 
     /// The scanners that placed any vertex, ascending (empty where not fused).
     pub fn scanners(&self) -> Vec<u16> {
         let mut s = self.scanner.clone();
+        s.sort_unstable();
+        s.dedup();
+        s
+    }
+
+    /// The passes that placed any vertex, ascending (empty where not fused).
+    pub fn passes(&self) -> Vec<u16> {
+        let mut s = self.pass.clone();
         s.sort_unstable();
         s.dedup();
         s
@@ -251,6 +285,20 @@ impl EdgeLine {
             points,
             detail,
             ..other.clone()
+        }
+    }
+
+    /// The line seen from the other direction of travel: vertices in reverse order, the
+    /// other side.
+    pub fn reversed(&self) -> Self {
+        Self {
+            points: self.points.iter().rev().copied().collect(),
+            detail: self.detail.as_ref().map(|d| Box::new(d.reversed())),
+            side: match self.side {
+                Side::Left => Side::Right,
+                Side::Right => Side::Left,
+            },
+            ..self.clone()
         }
     }
 
@@ -429,6 +477,7 @@ pub fn parse_geojson(name: &str, text: &str) -> Result<(Vec<EdgeLine>, Option<Cr
                             .and_then(|s| s.as_f64())
                             .unwrap_or(0.0),
                         scanner: Vec::new(),
+                        pass: Vec::new(),
                     })
                 });
             toe_edge.push(edge);

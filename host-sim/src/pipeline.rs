@@ -74,6 +74,9 @@ impl Method {
 pub struct ExtractOptions {
     /// `--scanner ID` (see `io::las_in`).
     pub scanner: Option<u16>,
+    /// `--pass N`: only the Nth pass the trajectory holds (`stream::passes`, from 0);
+    /// `None` extracts every pass and fuses them.
+    pub pass: Option<u16>,
     /// `--method`.
     pub method: Method,
 }

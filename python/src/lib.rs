@@ -174,6 +174,7 @@ fn extract_files(
     let cfg = config(config_path, config_json)?;
     let opts = ExtractOptions {
         scanner,
+        pass: None,
         method: method(method_name)?,
     };
     let window = window(section_m, margin_m);
@@ -367,6 +368,7 @@ fn run_task(
     let window = window(section_m, margin_m);
     let opts = ExtractOptions {
         scanner,
+        pass: None,
         method: Method::Bend,
     };
     let spec = TaskSpec {

@@ -113,6 +113,7 @@ fn extract(out: &Path, method: MethodArg, cfg: &Config, tty: bool) -> anyhow::Re
         MethodArg::Bend => {
             let opts = ExtractOptions {
                 scanner: None,
+                pass: None,
                 method: Method::Bend,
             };
             let r = pipeline::extract_file_with(&points, &traj, cfg, &opts, &progress)?;
@@ -152,6 +153,7 @@ fn extract(out: &Path, method: MethodArg, cfg: &Config, tty: bool) -> anyhow::Re
         MethodArg::Qiu => {
             let opts = ExtractOptions {
                 scanner: None,
+                pass: None,
                 method: Method::Qiu,
             };
             let t = Instant::now();

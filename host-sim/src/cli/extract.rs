@@ -69,6 +69,10 @@ pub struct Args {
     /// edges fused.
     #[arg(long)]
     pub scanner: Option<u16>,
+    /// Pass: only the Nth pass (from 0) of a trajectory that drives the same road again.
+    /// Without it every pass is extracted and the passes fused (docs/architecture.md, "Several passes").
+    #[arg(long)]
+    pub pass: Option<u16>,
     /// TOML file with the scanners' mounts (a `[scanners]` table, as `simulate --scanners 2`
     /// writes in `mounts.toml`); replaces the config's `[scanners]`.
     #[arg(long)]
@@ -124,6 +128,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let format = resolve(output, args.format.map(OutputFormat::from))?;
     let opts = ExtractOptions {
         scanner: args.scanner,
+        pass: args.pass,
         method: match args.method {
             MethodArg::Bend => Method::Bend,
             MethodArg::Qiu => Method::Qiu,

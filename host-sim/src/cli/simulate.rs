@@ -39,6 +39,13 @@ pub struct Args {
     /// channels 0 and 1 in one file, `mounts.toml` and a reference per scanner beside it).
     #[arg(long, default_value_t = 1, conflicts_with = "sensor")]
     pub scanners: u8,
+    /// Passes: 1, or 2 (the street driven back the other way after the first pass, its
+    /// GNSS solution offset by --pass-offset; a reference per pass beside it).
+    #[arg(long, default_value_t = 1, conflicts_with_all = ["sensor", "scanners"])]
+    pub passes: u8,
+    /// The second pass's GNSS offset from the first, metres (direction from the seed).
+    #[arg(long, default_value_t = 0.10, requires = "passes")]
+    pub pass_offset: f64,
 }
 
 /// Runs `curbtrace simulate`.
@@ -72,10 +79,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         println!("{}", spec.description);
     }
     let progress = std::io::stderr().is_terminal();
-    let s = match args.scanners {
-        1 => simulate::run_with(&spec, args.seed, args.speed, spin, &args.out, progress),
-        2 => simulate::dual::run_two(&spec, args.seed, args.speed, &args.out, progress),
-        n => anyhow::bail!("--scanners {n}: 1 or 2"),
+    let s = match (args.scanners, args.passes) {
+        (1, 1) => simulate::run_with(&spec, args.seed, args.speed, spin, &args.out, progress),
+        (2, 1) => simulate::dual::run_two(&spec, args.seed, args.speed, &args.out, progress),
+        (1, 2) => simulate::passes::run_passes(
+            &spec,
+            args.seed,
+            args.speed,
+            args.pass_offset,
+            &args.out,
+            progress,
+        ),
+        (n, 1) => anyhow::bail!("--scanners {n}: 1 or 2"),
+        (_, n) => anyhow::bail!("--passes {n}: 1 or 2"),
     }
     .with_context(|| format!("simulating scene {}", args.scene))?;
     let [curb, cut, inter, bay] = s.reference_m;

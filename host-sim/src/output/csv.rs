@@ -6,9 +6,10 @@ use std::path::Path;
 
 /// The header row: the toe vertex (`edge,side,vertex,x,y,z`, as in schema 1), then the
 /// stretch's class and support and, where the curb was surveyed, the top of curb beside the
-/// vertex and the curb height there (empty otherwise).
+/// vertex and the curb height there (empty otherwise), then where several scanners or
+/// passes were fused the scanner and the pass that placed the vertex (empty otherwise).
 pub const HEADER: &str =
-    "edge,side,vertex,x,y,z,category,bridged,support_per_m,top_x,top_y,top_z,height_m";
+    "edge,side,vertex,x,y,z,category,bridged,support_per_m,top_x,top_y,top_z,height_m,scanner,pass";
 
 /// Writes edges as CSV vertex lists, one row per toe vertex (see [`HEADER`]).
 pub fn write_edges(path: &Path, edges: &[EdgeLine]) -> std::io::Result<()> {
@@ -28,13 +29,21 @@ pub fn write_edges(path: &Path, edges: &[EdgeLine]) -> std::io::Result<()> {
             match e.detail.as_deref() {
                 Some(d) if v < d.top.len() && v < d.height_m.len() => {
                     let t = d.top[v];
+                    let id = |ids: &[u16]| ids.get(v).map(u16::to_string).unwrap_or_default();
                     writeln!(
                         w,
-                        "{},{:.2},{:.4},{:.4},{:.4},{:.4}",
-                        d.bridged, d.support_per_m, t[0], t[1], t[2], d.height_m[v]
+                        "{},{:.2},{:.4},{:.4},{:.4},{:.4},{},{}",
+                        d.bridged,
+                        d.support_per_m,
+                        t[0],
+                        t[1],
+                        t[2],
+                        d.height_m[v],
+                        id(&d.scanner),
+                        id(&d.pass)
                     )?;
                 }
-                _ => writeln!(w, ",,,,,")?,
+                _ => writeln!(w, ",,,,,,,")?,
             }
         }
     }

@@ -1,7 +1,9 @@
 //! Edges as AutoCAD DXF (ASCII, R12): one 3D POLYLINE per line of a stretch (toe and top of
 //! curb), in the LAS coordinates, on one layer per line kind and class (`TOE_CURB`,
 //! `TOP_CURB`, `TOE_CURB_CUT`, …, `TOE_UNCLASSIFIED`); bridged stretches are drawn with the
-//! line type `DASHED`. DXF has no place for a CRS: the file opens with DXF comment groups
+//! line type `DASHED`; a fused stretch's polylines carry the scanners and passes that
+//! contributed as extended data of the application `CURBTRACE` (`scanners=0;1`,
+//! `passes=0;1`). DXF has no place for a CRS: the file opens with DXF comment groups
 //! (code 999) naming the schema version and the CRS.
 
 use super::features::{features, LineKind};
@@ -9,10 +11,14 @@ use super::format::{OutputError, OutputFormat};
 use crate::model::{Category, Crs, EdgeLine, SCHEMA_MEMBER, SCHEMA_VERSION};
 use dxf::entities::{Entity, EntityType, Polyline, Vertex};
 use dxf::enums::AcadVersion;
-use dxf::tables::{Layer, LineType};
+use dxf::tables::{AppId, Layer, LineType};
 use dxf::{Color, Drawing, Point};
+use dxf::{XData, XDataItem};
 use std::io::Write;
 use std::path::Path;
+
+/// The application name of the extended data naming a fused stretch's scanners and passes.
+pub const XDATA_APP: &str = "CURBTRACE";
 
 /// The line type of bridged stretches.
 pub const BRIDGED_LINE_TYPE: &str = "DASHED";
@@ -86,6 +92,7 @@ pub fn write_dxf(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<(
             });
         }
     }
+    let mut app_id = false;
     for f in features(edges) {
         let mut poly = Polyline::default();
         poly.set_is_3d_polyline(true);
@@ -96,6 +103,23 @@ pub fn write_dxf(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<(
         entity.common.layer = layer_name(f.kind, f.stretch.category);
         if f.bridged() == Some(true) {
             entity.common.line_type_name = BRIDGED_LINE_TYPE.into();
+        }
+        let items: Vec<XDataItem> = [("scanners", f.scanners()), ("passes", f.passes())]
+            .into_iter()
+            .filter_map(|(k, v)| v.map(|v| XDataItem::Str(format!("{k}={v}"))))
+            .collect();
+        if !items.is_empty() {
+            if !app_id {
+                drawing.add_app_id(AppId {
+                    name: XDATA_APP.into(),
+                    ..Default::default()
+                });
+                app_id = true;
+            }
+            entity.common.x_data.push(XData {
+                application_name: XDATA_APP.into(),
+                items,
+            });
         }
         drawing.add_entity(entity);
     }

@@ -49,10 +49,33 @@ impl Feature<'_> {
         self.stretch.detail.as_ref().map(|d| d.bridged)
     }
 
+    /// The scanners that contributed to a fused stretch, ascending, as `0;1`; `None` where
+    /// the edges were not fused (one scanner, one pass).
+    pub fn scanners(&self) -> Option<String> {
+        self.stretch
+            .detail
+            .as_ref()
+            .and_then(|d| joined(&d.scanners()))
+    }
+
+    /// The passes that contributed to a fused stretch, ascending, as `0;1`; `None` where
+    /// the edges were not fused.
+    pub fn passes(&self) -> Option<String> {
+        self.stretch
+            .detail
+            .as_ref()
+            .and_then(|d| joined(&d.passes()))
+    }
+
     /// Observed candidates per metre of the stretch; `None` where unknown.
     pub fn support_per_m(&self) -> Option<f64> {
         self.stretch.detail.as_ref().map(|d| d.support_per_m)
     }
+}
+
+/// `ids` as `0;1`, `None` when empty.
+fn joined(ids: &[u16]) -> Option<String> {
+    (!ids.is_empty()).then(|| ids.iter().map(u16::to_string).collect::<Vec<_>>().join(";"))
 }
 
 /// The features of `edges` in file order: each stretch's toe, then its top where it has

@@ -15,7 +15,7 @@ use std::path::Path;
 pub const LAYER: &str = "edges";
 
 /// The attribute columns, in file order.
-const COLUMNS: [(&str, ColumnType, bool); 9] = [
+const COLUMNS: [(&str, ColumnType, bool); 11] = [
     ("side", ColumnType::String, false),
     ("method", ColumnType::String, true),
     ("length_m", ColumnType::Double, false),
@@ -25,6 +25,8 @@ const COLUMNS: [(&str, ColumnType, bool); 9] = [
     ("edge", ColumnType::Long, false),
     ("bridged", ColumnType::Bool, true),
     ("support_per_m", ColumnType::Double, true),
+    ("scanners", ColumnType::String, true),
+    ("passes", ColumnType::String, true),
 ];
 
 /// Writes `edges` as FlatGeobuf at `path`, replacing any file there.
@@ -65,6 +67,7 @@ pub fn write_fgb(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<(
     }
     for (i, f) in features(edges).iter().enumerate() {
         let e = f.stretch;
+        let (scanners, passes) = (f.scanners(), f.passes());
         let props = [
             Some(ColumnValue::String(e.side.as_str())),
             e.method.as_deref().map(ColumnValue::String),
@@ -75,6 +78,8 @@ pub fn write_fgb(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<(
             Some(ColumnValue::Long(f.edge as i64)),
             f.bridged().map(ColumnValue::Bool),
             f.support_per_m().map(ColumnValue::Double),
+            scanners.as_deref().map(ColumnValue::String),
+            passes.as_deref().map(ColumnValue::String),
         ];
         for (k, value) in props.iter().enumerate() {
             if let Some(v) = value {

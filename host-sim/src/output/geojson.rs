@@ -34,10 +34,11 @@ pub fn lines_to_geojson(lines: &[EdgeLine], crs: Option<&Crs>) -> serde_json::Va
                         json!(round_to(d.support_per_m, 1e-2)),
                     );
                 }
-                // Fused edges name the scanners that contributed.
-                let scanners = d.scanners();
-                if !scanners.is_empty() {
-                    props.insert("scanners".into(), json!(scanners));
+                // Fused edges name the scanners and passes that contributed.
+                for (key, ids) in [("scanners", d.scanners()), ("passes", d.passes())] {
+                    if !ids.is_empty() {
+                        props.insert(key.into(), json!(ids));
+                    }
                 }
                 if f.kind == LineKind::Toe {
                     let hs: Vec<f64> = d.height_m.iter().map(|&h| round_to(h, 1e-4)).collect();

@@ -72,7 +72,9 @@ CREATE TABLE edges (
   line TEXT NOT NULL,
   edge INTEGER NOT NULL,
   bridged BOOLEAN,
-  support_per_m DOUBLE
+  support_per_m DOUBLE,
+  scanners TEXT,
+  passes TEXT
 );
 ";
 
@@ -242,8 +244,8 @@ pub fn write_gpkg(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<
         let mut insert = tx
             .prepare(
                 "INSERT INTO edges (geom, side, method, length_m, curb_height_m, category, \
-                 line, edge, bridged, support_per_m) \
-                 VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10)",
+                 line, edge, bridged, support_per_m, scanners, passes) \
+                 VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12)",
             )
             .map_err(sql)?;
         for f in &feats {
@@ -262,6 +264,8 @@ pub fn write_gpkg(path: &Path, edges: &[EdgeLine], crs: Option<&Crs>) -> Result<
                     f.edge as i64,
                     f.bridged(),
                     f.support_per_m(),
+                    f.scanners(),
+                    f.passes(),
                 ])
                 .map_err(sql)?;
         }

@@ -31,6 +31,13 @@ pub struct Drive {
 
 /// Plans the drive at `speed_kmh`.
 pub fn plan(world: &World, speed_kmh: f64, seed: u64) -> Drive {
+    plan_pass(world, speed_kmh, seed, false, T0_GPS)
+}
+
+/// Plans a drive along the scene's path at `speed_kmh` whose first pulse fires at `t0`:
+/// from the drive's start to its end, or with `reverse` from its end back to its start
+/// (the same path, driven the other way).
+pub fn plan_pass(world: &World, speed_kmh: f64, seed: u64, reverse: bool, t0: f64) -> Drive {
     let spec = &world.spec;
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xD81E_0000_0000_0002);
     let ph = [
@@ -43,12 +50,21 @@ pub fn plan(world: &World, speed_kmh: f64, seed: u64) -> Drive {
     let margin_u = 3.0 * v0 + 10.0;
     let du = 0.05;
     let (u0, u1) = (spec.drive.0 - margin_u, spec.drive.1 + margin_u);
-    let n = ((u1 - u0) / du).ceil() as usize;
+    // `a` runs along the drive: u itself, or −u when driven back.
+    let sgn = if reverse { -1.0 } else { 1.0 };
+    let (a0, a1) = if reverse { (-u1, -u0) } else { (u0, u1) };
+    let (start, end) = if reverse {
+        (-spec.drive.1, -spec.drive.0)
+    } else {
+        spec.drive
+    };
+    let n = ((a1 - a0) / du).ceil() as usize;
     let mut xy = Vec::with_capacity(n + 1);
     let mut us = Vec::with_capacity(n + 1);
     for i in 0..=n {
-        let u = u0 + (u1 - u0) * i as f64 / n as f64;
-        us.push(u);
+        let a = a0 + (a1 - a0) * i as f64 / n as f64;
+        us.push(a);
+        let u = sgn * a;
         xy.push(world.center.map(u, world.lane_v(u)));
     }
     let mut s = vec![0.0; xy.len()];
@@ -68,16 +84,16 @@ pub fn plan(world: &World, speed_kmh: f64, seed: u64) -> Drive {
         let w = (u - us[k - 1]) / (us[k] - us[k - 1]);
         t[k - 1] + (t[k] - t[k - 1]) * w
     };
-    // Shift so the first pulse fires at T0_GPS; lines cover the drive.
-    let shift = T0_GPS - t_at_u(spec.drive.0);
-    let lines = ((t_at_u(spec.drive.1) - t_at_u(spec.drive.0)) * spec.scanner.line_rate_hz).ceil();
-    let scan = (T0_GPS, T0_GPS + lines / spec.scanner.line_rate_hz);
+    // Shift so the first pulse fires at t0; lines cover the drive.
+    let shift = t0 - t_at_u(start);
+    let lines = ((t_at_u(end) - t_at_u(start)) * spec.scanner.line_rate_hz).ceil();
+    let scan = (t0, t0 + lines / spec.scanner.line_rate_hz);
     let length_m = {
         let sa = |u: f64| {
             let k = us.partition_point(|&x| x <= u).clamp(1, us.len() - 1);
             s[k - 1]
         };
-        sa(spec.drive.1) - sa(spec.drive.0)
+        sa(end) - sa(start)
     };
     // Position along the path by time.
     let at_time = |tt: f64| -> ([f64; 2], [f64; 2]) {

@@ -17,7 +17,7 @@
 use super::reference::{self, Visibility};
 use super::scanner::{self, Return, ScannerConfig, VehicleBody};
 use super::{line_seed, simulate, SceneSpec, SimError, SimSummary, Simulation};
-use crate::model::{Category, Crs, EdgeLine};
+use crate::model::{Crs, EdgeLine};
 use crate::mounts::{Mount, Mounts};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -228,31 +228,14 @@ pub fn run_two(
             }
         })?;
     }
-    let mut reference_m = [0.0; 4];
-    for l in &sim.reference {
-        if let Some(c) = l.category {
-            let i = Category::REFERENCE
-                .iter()
-                .position(|&x| x == c)
-                .unwrap_or(0);
-            reference_m[i] += l.length_m();
-        }
-    }
-    Ok(SimSummary {
-        scene: spec.name.clone(),
-        points: sim.returns.len(),
-        lines: sim.lines,
-        length_m: sim.length_m,
-        duration_s: sim.scan.1 - sim.scan.0,
-        reference_m,
-        elapsed_s: start.elapsed().as_secs_f64(),
+    Ok(SimSummary::of(
+        spec,
+        sim,
+        start,
         simulate_s,
-        write_s: start.elapsed().as_secs_f64() - simulate_s,
-        points_path,
-        trajectory_path,
-        reference_path,
+        [points_path, trajectory_path, reference_path],
         crs,
-    })
+    ))
 }
 
 #[cfg(test)]

@@ -11,6 +11,7 @@
 //! | [`ground`] | road, curbs (batter, rounded top), curb cuts, sidewalks as an exact height field |
 //! | [`prims`] | walls, fences, parked cars, poles, weeds, leaves, and the ray walk through them |
 //! | [`dual`] | two profilers in an X (`--scanners 2`): the mirrored second scanner, interleaved returns, a reference per scanner |
+//! | [`passes`] | the street driven twice (`--passes 2`): the second pass back the other way, offset |
 //! | [`drive`] | the vehicle's path, speed and attitude → the 200 Hz trajectory |
 //! | [`scanner`] | the VQ-250-like profiler: pulse directions and timing, noise, intensity |
 //! | [`spinning`] | spinning multi-beam lidars (VLP-16, HDL-32E, HDL-64E, OS1-64) on the roof |
@@ -45,6 +46,7 @@ pub mod centerline;
 pub mod drive;
 pub mod dual;
 pub mod ground;
+pub mod passes;
 pub mod prims;
 pub mod reference;
 pub mod scanner;
@@ -182,6 +184,46 @@ pub struct SimSummary {
     pub crs: Crs,
 }
 
+impl SimSummary {
+    /// The summary of `sim` of `spec` written to `[points, trajectory, reference]` in
+    /// `crs`: the run started at `start`, its first `simulate_s` seconds simulating.
+    pub fn of(
+        spec: &SceneSpec,
+        sim: &Simulation,
+        start: Instant,
+        simulate_s: f64,
+        [points_path, trajectory_path, reference_path]: [PathBuf; 3],
+        crs: Crs,
+    ) -> Self {
+        let mut reference_m = [0.0; 4];
+        for l in &sim.reference {
+            if let Some(c) = l.category {
+                let i = Category::REFERENCE
+                    .iter()
+                    .position(|&x| x == c)
+                    .unwrap_or(0);
+                reference_m[i] += l.length_m();
+            }
+        }
+        let elapsed_s = start.elapsed().as_secs_f64();
+        SimSummary {
+            scene: spec.name.clone(),
+            points: sim.returns.len(),
+            lines: sim.lines,
+            length_m: sim.length_m,
+            duration_s: sim.scan.1 - sim.scan.0,
+            reference_m,
+            elapsed_s,
+            simulate_s,
+            write_s: elapsed_s - simulate_s,
+            points_path,
+            trajectory_path,
+            reference_path,
+            crs,
+        }
+    }
+}
+
 fn line_seed(seed: u64, k: u64) -> u64 {
     // splitmix64 of the pair: independent streams per line, fixed by (seed, k) alone.
     let mut z = seed ^ k.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x243F_6A88_85A3_08D3;
@@ -227,38 +269,7 @@ pub fn simulate_with(
     if let Some(sensor) = sensor {
         return Ok(simulate_revolutions(world, drive, sensor, seed, progress));
     }
-    let cfg = world.spec.scanner;
-    let dirs = scanner::mount_directions(&cfg);
-    let own: Vec<bool> = dirs
-        .iter()
-        .map(|&d| scanner::hits_own_vehicle(d, cfg.height_m, &cfg.body))
-        .collect();
-    let lines = ((drive.scan.1 - drive.scan.0) * cfg.line_rate_hz).round() as usize;
-    let bar = progress.then(|| {
-        let b = indicatif::ProgressBar::new(lines as u64);
-        b.set_style(
-            indicatif::ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} lines, {eta}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        b.set_message(format!("simulating {}", spec.name));
-        b
-    });
-    let per_line: Vec<Vec<scanner::Return>> = (0..lines)
-        .into_par_iter()
-        .map(|k| {
-            let mut rng = ChaCha8Rng::seed_from_u64(line_seed(seed, k as u64));
-            let t_line = drive.scan.0 + k as f64 / cfg.line_rate_hz;
-            let r = scanner::cast_line(&world, &drive.traj, &dirs, &own, t_line, &mut rng);
-            if let Some(b) = &bar {
-                b.inc(1);
-            }
-            r
-        })
-        .collect();
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
-    let returns: Vec<scanner::Return> = per_line.into_iter().flatten().collect();
+    let (returns, lines) = cast_drive(&world, &drive, seed, progress);
     let mut vis = reference::Visibility::new(&world.ground);
     for r in &returns {
         if let Some(tc) = &r.toe {
@@ -275,6 +286,48 @@ pub fn simulate_with(
         length_m: drive.length_m,
         scan: drive.scan,
     })
+}
+
+/// The scene's profiler over `drive`: every line from its own generator seeded by
+/// `(seed, line)`, gathered in order; the returns and the number of lines.
+pub(crate) fn cast_drive(
+    world: &World,
+    drive: &drive::Drive,
+    seed: u64,
+    progress: bool,
+) -> (Vec<scanner::Return>, usize) {
+    let cfg = world.spec.scanner;
+    let dirs = scanner::mount_directions(&cfg);
+    let own: Vec<bool> = dirs
+        .iter()
+        .map(|&d| scanner::hits_own_vehicle(d, cfg.height_m, &cfg.body))
+        .collect();
+    let lines = ((drive.scan.1 - drive.scan.0) * cfg.line_rate_hz).round() as usize;
+    let bar = progress.then(|| {
+        let b = indicatif::ProgressBar::new(lines as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{msg} {bar:40} {pos}/{len} lines, {eta}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b.set_message(format!("simulating {}", world.spec.name));
+        b
+    });
+    let per_line: Vec<Vec<scanner::Return>> = (0..lines)
+        .into_par_iter()
+        .map(|k| {
+            let mut rng = ChaCha8Rng::seed_from_u64(line_seed(seed, k as u64));
+            let t_line = drive.scan.0 + k as f64 / cfg.line_rate_hz;
+            let r = scanner::cast_line(world, &drive.traj, &dirs, &own, t_line, &mut rng);
+            if let Some(b) = &bar {
+                b.inc(1);
+            }
+            r
+        })
+        .collect();
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    (per_line.into_iter().flatten().collect(), lines)
 }
 
 /// The revolutions of a spinning sensor over the drive, every one from its own generator
@@ -385,31 +438,14 @@ pub fn run_with(
             what: e.to_string(),
         },
     )?;
-    let mut reference_m = [0.0; 4];
-    for l in &sim.reference {
-        if let Some(c) = l.category {
-            let i = Category::REFERENCE
-                .iter()
-                .position(|&x| x == c)
-                .unwrap_or(0);
-            reference_m[i] += l.length_m();
-        }
-    }
-    Ok(SimSummary {
-        scene: spec.name.clone(),
-        points: sim.returns.len(),
-        lines: sim.lines,
-        length_m: sim.length_m,
-        duration_s: sim.scan.1 - sim.scan.0,
-        reference_m,
-        elapsed_s: start.elapsed().as_secs_f64(),
+    Ok(SimSummary::of(
+        spec,
+        &sim,
+        start,
         simulate_s,
-        write_s: start.elapsed().as_secs_f64() - simulate_s,
-        points_path,
-        trajectory_path,
-        reference_path,
+        [points_path, trajectory_path, reference_path],
         crs,
-    })
+    ))
 }
 
 #[cfg(test)]

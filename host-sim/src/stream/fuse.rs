@@ -1,4 +1,5 @@
-//! Fusion: the closed edges of several channels (scanners) made one edge per curb.
+//! Fusion: the closed edges of several channels (scanners) and passes made one edge per
+//! curb.
 //!
 //! Fusion is late: each scanner's scanlines run through a core and a tracker of their own
 //! (as each scanner's controller would), and the closed edges are fused here. Early
@@ -9,7 +10,8 @@
 //!
 //! The rule: every edge is cut into its observed runs (vertices resting on candidates) and
 //! its bridged runs (placed by the tracker over at least `model::BRIDGED_MIN_M`). Observed runs
-//! come first, longest first, then bridged runs, longest first. A run's vertex is a
+//! come first, those of the first pass before later passes', longest first, then bridged
+//! runs in the same order. A run's vertex is a
 //! duplicate when an already kept line of the same side passes within [`FuseParams::near_m`]
 //! of it in a direction within [`FuseParams::max_angle_deg`]; the vertices that are not
 //! duplicates are kept, in runs, each with the duplicate vertex beside it so it meets the
@@ -76,13 +78,25 @@ pub fn add_summaries(mut a: ExtractResult, b: &ExtractResult) -> ExtractResult {
 struct Run {
     line: EdgeLine,
     observed: bool,
+    pass: u16,
 }
 
-/// Fuses the edges of several channels, `(channel key, its closed edges)`. Every vertex
-/// of the result records the channel whose tracker placed it (`CurbDetail::scanner`).
-pub fn fuse(channels: Vec<(u16, Vec<EdgeLine>)>, p: &FuseParams) -> Vec<EdgeLine> {
+/// A source of edges: a scanner (channel key) in a pass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Source {
+    /// The scanner's channel key.
+    pub scanner: u16,
+    /// The pass (`stream::passes`), 0 for the first.
+    pub pass: u16,
+}
+
+/// Fuses the edges of several sources, each `(source, its closed edges)`, the edges of
+/// later passes already turned to the first pass's direction. Every vertex of the result
+/// records the scanner and the pass whose tracker placed it (`CurbDetail::scanner`,
+/// `CurbDetail::pass`).
+pub fn fuse(channels: Vec<(Source, Vec<EdgeLine>)>, p: &FuseParams) -> Vec<EdgeLine> {
     let mut runs = Vec::new();
-    for (key, edges) in channels {
+    for (src, edges) in channels {
         for mut e in edges {
             let n = e.points.len();
             if n < 2 {
@@ -90,7 +104,8 @@ pub fn fuse(channels: Vec<(u16, Vec<EdgeLine>)>, p: &FuseParams) -> Vec<EdgeLine
             }
             let measured = match e.detail.as_mut() {
                 Some(d) => {
-                    d.scanner = vec![key; n];
+                    d.scanner = vec![src.scanner; n];
+                    d.pass = vec![src.pass; n];
                     d.measured.clone()
                 }
                 None => vec![true; n],
@@ -100,15 +115,18 @@ pub fn fuse(channels: Vec<(u16, Vec<EdgeLine>)>, p: &FuseParams) -> Vec<EdgeLine
                     runs.push(Run {
                         line: e.sub(a, b + 1),
                         observed: !bridged,
+                        pass: src.pass,
                     });
                 }
             }
         }
     }
-    // Observed before bridged, longer before shorter; ties in input order.
+    // Observed before bridged, the first pass before later ones (its geometry is the
+    // frame the others were shifted onto), longer before shorter; ties in input order.
     runs.sort_by(|a, b| {
         b.observed
             .cmp(&a.observed)
+            .then(a.pass.cmp(&b.pass))
             .then(b.line.length_m().total_cmp(&a.line.length_m()))
     });
     let mut kept: Vec<EdgeLine> = Vec::new();
@@ -318,6 +336,14 @@ mod tests {
     use super::*;
     use crate::model::{CurbDetail, Side};
 
+    /// Scanner `k` of the first pass.
+    fn ch(k: u16) -> Source {
+        Source {
+            scanner: k,
+            pass: 0,
+        }
+    }
+
     /// An edge along y = `y` from x0 to x1 with vertices every 0.1 m; `measured` says
     /// which x ranges rest on candidates (all when empty).
     fn edge(x0: f64, x1: f64, y: f64, unmeasured: &[(f64, f64)]) -> EdgeLine {
@@ -365,7 +391,7 @@ mod tests {
         // 8–17 m, 0.04 m off.
         let s0 = vec![edge(0.0, 10.0, 0.0, &[]), edge(15.0, 30.0, 0.0, &[])];
         let s1 = vec![edge(8.0, 17.0, 0.04, &[])];
-        let out = fuse(vec![(0, s0), (1, s1)], &FuseParams::default());
+        let out = fuse(vec![(ch(0), s0), (ch(1), s1)], &FuseParams::default());
         assert_eq!(out.len(), 1, "{out:?}");
         let e = &out[0];
         assert!((e.length_m() - 30.0).abs() < 0.3, "{}", e.length_m());
@@ -389,7 +415,7 @@ mod tests {
         // only as short pieces.
         let s0 = vec![edge(0.0, 30.0, 0.0, &[(8.0, 16.0)])];
         let s1 = vec![edge(7.0, 12.0, -0.05, &[]), edge(12.2, 17.0, -0.05, &[])];
-        let out = fuse(vec![(0, s0), (1, s1)], &FuseParams::default());
+        let out = fuse(vec![(ch(0), s0), (ch(1), s1)], &FuseParams::default());
         assert_eq!(out.len(), 1, "{out:?}");
         let d = out[0].detail.as_ref().unwrap();
         // Between 8 and 16 m the vertices are scanner 1's observed ones, except the 0.2 m
@@ -414,14 +440,14 @@ mod tests {
             *q = [5.0, q[0], 0.0];
         }
         let b = vec![edge(0.0, 10.0, 2.0, &[]), across];
-        let out = fuse(vec![(0, a), (1, b)], &FuseParams::default());
+        let out = fuse(vec![(ch(0), a), (ch(1), b)], &FuseParams::default());
         let total: f64 = out.iter().map(|e| e.length_m()).sum();
         assert!((total - 30.0).abs() < 0.5, "{total}");
         // The other side is never a duplicate.
         let mut r = edge(0.0, 10.0, 0.0, &[]);
         r.side = Side::Right;
         let out = fuse(
-            vec![(0, vec![edge(0.0, 10.0, 0.0, &[])]), (1, vec![r])],
+            vec![(ch(0), vec![edge(0.0, 10.0, 0.0, &[])]), (ch(1), vec![r])],
             &FuseParams::default(),
         );
         assert_eq!(out.len(), 2);
@@ -432,9 +458,70 @@ mod tests {
         // Scanner 1 drops out from 12 m on; scanner 0 has everything.
         let s0 = vec![edge(0.0, 40.0, 0.0, &[])];
         let s1 = vec![edge(0.0, 12.0, 0.02, &[])];
-        let out = fuse(vec![(0, s0), (1, s1)], &FuseParams::default());
+        let out = fuse(vec![(ch(0), s0), (ch(1), s1)], &FuseParams::default());
         assert_eq!(out.len(), 1);
         assert!((out[0].length_m() - 40.0).abs() < 1e-6);
         assert_eq!(out[0].detail.as_ref().unwrap().scanners(), vec![0]);
+    }
+
+    #[test]
+    fn two_passes_in_opposite_directions_give_one_edge_in_the_first_pass_frame() {
+        // Pass 0 drives east and sees the left curb at y = 0 over 0–12 m and 18–40 m (a
+        // parked car hides 12–18 m). Pass 1 drives back west, 0.1 m off (GNSS drift): it
+        // sees the same curb on its right over 5–30 m.
+        let p0 = vec![edge(0.0, 12.0, 0.0, &[]), edge(18.0, 40.0, 0.0, &[])];
+        let mut back = edge(5.0, 30.0, 0.1, &[]).reversed();
+        back.side = Side::Right;
+        // As extract does: turned to pass 0's direction, shifted onto its edges.
+        let mut p1 = vec![back.reversed()];
+        assert_eq!(p1[0].side, Side::Left);
+        let t = crate::stream::passes::shift_onto(&p0, &p1).expect("a shift");
+        assert!((t[1] + 0.1).abs() < 0.01 && t[0].abs() < 0.01, "{t:?}");
+        crate::stream::passes::shifted(&mut p1, t);
+        let pass = |k: u16| Source {
+            scanner: 0,
+            pass: k,
+        };
+        let out = fuse(vec![(pass(0), p0), (pass(1), p1)], &FuseParams::default());
+        assert_eq!(out.len(), 1, "{out:?}");
+        let e = &out[0];
+        assert!((e.length_m() - 40.0).abs() < 0.3, "{}", e.length_m());
+        assert!(
+            e.points.windows(2).all(|w| w[1][0] > w[0][0]),
+            "pass 0's direction"
+        );
+        assert!(e.points.iter().all(|p| p[1].abs() < 0.02), "on the curb");
+        let d = e.detail.as_ref().unwrap();
+        assert_eq!(d.passes(), vec![0, 1]);
+        // Pass 1 fills the 6 m pass 0 missed, nothing more.
+        let from1: f64 = e
+            .points
+            .windows(2)
+            .zip(d.pass.windows(2))
+            .filter(|(_, s)| s[0] == 1 && s[1] == 1)
+            .map(|(w, _)| w[1][0] - w[0][0])
+            .sum();
+        assert!((5.0..=6.5).contains(&from1), "{from1}");
+        assert!(doubled_m(&out, 0.3) < 0.5);
+    }
+
+    #[test]
+    fn two_overlapping_sections_give_one_edge() {
+        // Two sections of a campaign overlap over 20–30 m of one curb.
+        let a = vec![edge(0.0, 30.0, 0.0, &[])];
+        let b = vec![edge(20.0, 50.0, 0.01, &[])];
+        let sec = |k: u16| Source {
+            scanner: 0,
+            pass: k,
+        };
+        let out = fuse(vec![(sec(0), a), (sec(1), b)], &FuseParams::default());
+        assert_eq!(out.len(), 1, "{out:?}");
+        assert!(
+            (out[0].length_m() - 50.0).abs() < 0.1,
+            "{}",
+            out[0].length_m()
+        );
+        assert!(doubled_m(&out, 0.3) < 0.5);
+        assert_eq!(out[0].detail.as_ref().unwrap().passes(), vec![0, 1]);
     }
 }

@@ -17,13 +17,15 @@
 //!   every half revolution of a ring a scanline).
 //! - [`window`] — sections along the route, the bend method per window.
 //! - [`merge`] — joining pieces at section boundaries.
-//! - [`fuse`] — the edges of several scanners (channels) made one edge per curb.
+//! - [`passes`] — a trajectory that drives the same road again cut into passes.
+//! - [`fuse`] — the edges of several scanners (channels) and passes made one edge per curb.
 //! - [`tasks`] — the campaign cut into independent tasks of whole sections, merged after.
 
 pub mod core_stage;
 pub mod fuse;
 pub mod malloc;
 pub mod merge;
+pub mod passes;
 pub mod ring_stage;
 pub mod tasks;
 pub mod window;
@@ -82,41 +84,65 @@ pub fn extract(
         return Err(ExtractError::Method(opts.method.as_str().into()));
     }
     let traj = Trajectory::read_csv(traj_path)?;
+    let all_passes = passes::passes(&traj);
+    let passes: Vec<usize> = match opts.pass {
+        None => (0..all_passes.len()).collect(),
+        Some(k) if usize::from(k) < all_passes.len() => vec![usize::from(k)],
+        Some(k) => {
+            return Err(ExtractError::Stream {
+                path: traj_path.to_path_buf(),
+                what: format!(
+                    "--pass {k}: the trajectory holds {} pass(es), numbered from 0",
+                    all_passes.len()
+                ),
+            })
+        }
+    };
+    if all_passes.len() > 1 || opts.pass.is_some() {
+        let keys = match opts.scanner {
+            Some(k) => vec![k],
+            None => scanner_channels(inputs)?,
+        };
+        let r = extract_fused(
+            inputs,
+            &all_passes,
+            &passes,
+            &keys,
+            traj_path,
+            cfg,
+            opts,
+            window,
+            progress,
+        )?;
+        return Ok(finish(r));
+    }
     let origin = cfg.scanners.get(opts.scanner.unwrap_or(0)).apply(&traj);
-    let mut result = match extract_channel(inputs, &origin, traj_path, cfg, opts, window, progress)
-    {
+    let result = match extract_channel(
+        inputs, &origin, traj_path, cfg, opts, window, progress, true,
+    ) {
         Err(ExtractError::Source(SourceError::Las(
             crate::io::las_in::LasError::SeveralScanners { channels, .. },
         ))) if opts.scanner.is_none() => {
-            let mut per = Vec::with_capacity(channels.len());
-            let mut all: Option<ExtractResult> = None;
-            for c in channels {
-                let key = u16::from(c);
-                let one = ExtractOptions {
-                    scanner: Some(key),
-                    ..*opts
-                };
-                let origin = cfg.scanners.get(key).apply(&traj);
-                let r = extract_channel(inputs, &origin, traj_path, cfg, &one, window, progress)?;
-                per.push((key, r.edges.clone()));
-                all = Some(match all {
-                    None => r,
-                    Some(a) => fuse::add_summaries(a, &r),
-                });
-            }
-            let mut r = all.ok_or_else(|| ExtractError::Stream {
-                path: inputs.first().cloned().unwrap_or_default(),
-                what: "no scanner channel to read".into(),
-            })?;
-            let params = fuse::FuseParams {
-                min_length_m: cfg.bend.min_edge_length_m,
-                ..fuse::FuseParams::default()
-            };
-            r.edges = fuse::fuse(per, &params);
-            r
+            let keys: Vec<u16> = channels.into_iter().map(u16::from).collect();
+            extract_fused(
+                inputs,
+                &all_passes,
+                &[0],
+                &keys,
+                traj_path,
+                cfg,
+                opts,
+                window,
+                progress,
+            )?
         }
         other => other?,
     };
+    Ok(finish(result))
+}
+
+/// The closed edges of `result` cut into stretches, its summary's edge count and length.
+fn finish(mut result: ExtractResult) -> ExtractResult {
     // The closed edges, cut into stretches of one class and one kind of support.
     result.edges = crate::curb::finish(std::mem::take(&mut result.edges));
     for e in &mut result.edges {
@@ -125,11 +151,145 @@ pub fn extract(
     }
     result.summary.edges = result.edges.len() as u64;
     result.summary.total_length_m = result.edges.iter().map(|e| e.length_m()).sum();
-    Ok(result)
+    result
+}
+
+/// The scanner channels of the input: `[0]` when it holds one scanner's points (or reads
+/// them by point source id), the channels in use otherwise.
+fn scanner_channels(inputs: &[PathBuf]) -> Result<Vec<u16>, ExtractError> {
+    let read = ReadOptions { scanner: None };
+    let mut c = Campaign::open(inputs, &read).map_err(ExtractError::Source)?;
+    match c.next_batch(STREAM_BATCH_POINTS) {
+        Err(SourceError::Las(crate::io::las_in::LasError::SeveralScanners {
+            channels, ..
+        })) => Ok(channels.into_iter().map(u16::from).collect()),
+        _ => Ok(vec![0]),
+    }
+}
+
+/// Every scanner of `keys` in the passes `which` of `passes` through a core and a tracker
+/// of its own; the edges of a later pass turned to the first pass's direction where it
+/// drove against it and shifted onto the first pass's edges (the GNSS drift between
+/// passes, [`passes::shift_onto`]); all fused ([`fuse`]). The summary adds up the runs'; a
+/// point outside the passes' trajectories is counted once, before the first or after the
+/// last.
+#[allow(clippy::too_many_arguments)]
+fn extract_fused(
+    inputs: &[PathBuf],
+    passes: &[Trajectory],
+    which: &[usize],
+    keys: &[u16],
+    traj_path: &Path,
+    cfg: &Config,
+    opts: &ExtractOptions,
+    window: &WindowParams,
+    progress: &Progress,
+) -> Result<ExtractResult, ExtractError> {
+    let mut per = Vec::with_capacity(keys.len() * passes.len());
+    let mut all: Option<ExtractResult> = None;
+    let mut kept = 0u64;
+    let (mut read, mut before) = (0u64, 0u64);
+    // The first pass's edges of every scanner, to shift later passes onto.
+    let mut first_edges: Vec<EdgeLine> = Vec::new();
+    for (n, &k) in which.iter().enumerate() {
+        let pass = &passes[k];
+        let turn = (k > 0).then(|| passes::Orientation::new(&passes[0], pass));
+        let mut this: Vec<(fuse::Source, Vec<EdgeLine>)> = Vec::new();
+        for &key in keys {
+            let one = ExtractOptions {
+                scanner: (keys.len() > 1 || opts.scanner.is_some()).then_some(key),
+                ..*opts
+            };
+            let origin = cfg.scanners.get(key).apply(pass);
+            let alone = which.len() == 1 && passes.len() == 1;
+            let r = extract_channel(
+                inputs, &origin, traj_path, cfg, &one, window, progress, alone,
+            )?;
+            let s = &r.summary;
+            let points =
+                s.las.points_selected - s.dropped_before_trajectory - s.dropped_after_trajectory;
+            kept += points;
+            if n == 0 {
+                read += s.las.points_selected;
+                before += s.dropped_before_trajectory;
+            }
+            let edges = match &turn {
+                None => r.edges.clone(),
+                Some(o) => r
+                    .edges
+                    .iter()
+                    .map(|e| {
+                        let mid = e.points[e.points.len() / 2];
+                        if o.reversed_at([mid[0], mid[1]]) {
+                            e.reversed()
+                        } else {
+                            e.clone()
+                        }
+                    })
+                    .collect(),
+            };
+            let src = fuse::Source {
+                scanner: key,
+                pass: k as u16,
+            };
+            this.push((src, edges));
+            all = Some(match all {
+                None => r,
+                Some(a) => fuse::add_summaries(a, &r),
+            });
+        }
+        if k == 0 {
+            first_edges = this.iter().flat_map(|(_, e)| e.iter().cloned()).collect();
+        } else if which.len() > 1 {
+            let mine: Vec<EdgeLine> = this.iter().flat_map(|(_, e)| e.iter().cloned()).collect();
+            if let Some(t) = passes::shift_onto(&first_edges, &mine) {
+                for (_, e) in &mut this {
+                    passes::shifted(e, t);
+                }
+            }
+        }
+        per.extend(this);
+    }
+    let mut r = all.ok_or_else(|| ExtractError::Stream {
+        path: inputs.first().cloned().unwrap_or_default(),
+        what: "no scanner channel to read".into(),
+    })?;
+    if which.len() > 1 || passes.len() > 1 {
+        // Every pass read every point: count each point once.
+        let s = &mut r.summary;
+        s.las.points_selected = read;
+        s.dropped_before_trajectory = before;
+        s.dropped_after_trajectory = read.saturating_sub(kept + before);
+        if which.len() == passes.len()
+            && (kept == 0 || (kept as f64) < MIN_COVERED_FRACTION * read as f64)
+        {
+            let first = inputs.first().cloned().unwrap_or_default();
+            let full = Trajectory::read_csv(traj_path)?;
+            return Err(ExtractError::Trajectory(full.not_covering(
+                traj_path,
+                &first,
+                (f64::NAN, f64::NAN),
+                kept as usize,
+                read as usize,
+            )));
+        }
+    }
+    let params = fuse::FuseParams {
+        min_length_m: cfg.bend.min_edge_length_m,
+        ..fuse::FuseParams::default()
+    };
+    r.edges = if per.len() == 1 {
+        per.pop().map(|(_, e)| e).unwrap_or_default()
+    } else {
+        fuse::fuse(per, &params)
+    };
+    Ok(r)
 }
 
 /// [`extract`] of one channel (or of every point, one scanner) with the scanner origin's
-/// trajectory `traj`: the closed edges before they are cut into stretches.
+/// trajectory `traj`: the closed edges before they are cut into stretches. `whole`: `traj`
+/// is the whole trajectory, which must cover most points (a pass's covers its own).
+#[allow(clippy::too_many_arguments)]
 fn extract_channel(
     inputs: &[PathBuf],
     traj: &Trajectory,
@@ -138,6 +298,7 @@ fn extract_channel(
     opts: &ExtractOptions,
     window: &WindowParams,
     progress: &Progress,
+    whole: bool,
 ) -> Result<ExtractResult, ExtractError> {
     // laz-rs decompresses on rayon's global pool, which nothing else in the stream uses:
     // its threads are named for the reader when the process has not built it yet.
@@ -219,7 +380,7 @@ fn extract_channel(
     };
     let (pass, selection) = pass;
     let read = pass.points + pass.dropped.0 + pass.dropped.1;
-    if pass.points == 0 || (pass.points as f64) < MIN_COVERED_FRACTION * read as f64 {
+    if whole && (pass.points == 0 || (pass.points as f64) < MIN_COVERED_FRACTION * read as f64) {
         let span = pass.time_span.unwrap_or((f64::NAN, f64::NAN));
         return Err(ExtractError::Trajectory(traj.not_covering(
             traj_path,
