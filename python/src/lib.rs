@@ -480,6 +480,7 @@ fn detail_from(v: &Value) -> Option<CurbDetail> {
         bridged: v["bridged"].as_bool()?,
         support_per_m: f64::from_bits(v["support_per_m"].as_u64()?),
         scanner: Vec::new(),
+        pass: Vec::new(),
     })
 }
 
