@@ -176,6 +176,13 @@ pub struct QiuParams {
     /// width step's tolerance, more than a swerve around a parked car moves a curb's
     /// offset within one cluster.
     pub cluster_keep_spread_m: f64,
+    /// Such a cluster is kept whole only when its line turns away from the road at its
+    /// outer end by at least this angle to the heading, degrees (see
+    /// `refine::refine_by_continuity`): a corner's arc does, up to the 45° where
+    /// `split_across` takes its rest; a curb whose offset changes with a road-width change
+    /// (at most 9° on random streets) or a lane change (at most 26°: 7.6 m over 25 m) does
+    /// not. Not in the paper. 30°, between the two; 0 keeps every thin spread cluster.
+    pub cluster_keep_turn_deg: f64,
     /// Points of a cluster are summarised every this many metres along its main direction
     /// before fitting line segments. Not in the paper.
     pub bin_m: f64,
@@ -249,6 +256,7 @@ impl Default for QiuParams {
             min_cluster_points: 5,
             cluster_keep_share: 0.5,
             cluster_keep_spread_m: 1.5,
+            cluster_keep_turn_deg: 30.0,
             bin_m: 0.5,
             segment_tolerance_m: 0.1,
             join_gap_m: 5.0,
@@ -311,6 +319,7 @@ impl QiuParams {
             ("low_beta_corridor_m", self.low_beta_corridor_m),
             ("low_beta_window_m", self.low_beta_window_m),
             ("cluster_keep_spread_m", self.cluster_keep_spread_m),
+            ("cluster_keep_turn_deg", self.cluster_keep_turn_deg),
             ("bridge_gap_m", self.bridge_gap_m),
         ];
         for (name, v) in nonneg {
@@ -319,6 +328,12 @@ impl QiuParams {
                     "{name} must be zero or more, found {v}"
                 )));
             }
+        }
+        if self.cluster_keep_turn_deg > 90.0 {
+            return Err(QiuParamsError(format!(
+                "cluster_keep_turn_deg must be at most 90, found {}",
+                self.cluster_keep_turn_deg
+            )));
         }
         if self.max_step_m < self.min_step_m {
             return Err(QiuParamsError(format!(

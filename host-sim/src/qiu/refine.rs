@@ -761,13 +761,17 @@ pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParam
                 continue;
             }
             // A cluster that leaves the road's offsets is kept whole when it is one thin
-            // line (a corner's arc), not a patch of scattered candidates.
+            // line (not a patch of scattered candidates) that turns away from the road at
+            // its outer end, as a corner's arc does; a curb whose offset changes because
+            // the road widens or the vehicle changes lanes stays parallel to the heading.
             if params.cluster_keep_spread_m > 0.0
                 && d_hi - d_lo >= params.cluster_keep_spread_m
                 && members.len() >= params.min_cluster_points
             {
                 if let Some(c) = fit_segments(pts, &members, &[], params) {
-                    if is_thin_line(&c, pts, &members, 2.0 * params.segment_tolerance_m) {
+                    if is_thin_line(&c, pts, &members, 2.0 * params.segment_tolerance_m)
+                        && turns_away(&c, pts, &members, params.cluster_keep_turn_deg)
+                    {
                         pieces.push(c);
                         continue;
                     }
@@ -788,6 +792,39 @@ pub fn refine_by_continuity(pts: &[EdgePoint], kept: &[usize], params: &QiuParam
         }
     }
     join_chains(pieces, params)
+}
+
+/// Whether the chain's segment at its outer end (the end whose nearest candidate lies
+/// farther from the trajectory) runs away from the trajectory at `min_deg` or more to the
+/// heading there. The heading is taken square to the nearest candidate's offset vector
+/// (`p − foot`).
+fn turns_away(c: &Chain, pts: &[EdgePoint], members: &[usize], min_deg: f64) -> bool {
+    let n = c.pts.len();
+    if n < 2 {
+        return false;
+    }
+    let nearest = |v: [f64; 3]| {
+        members.iter().copied().min_by(|&a, &b| {
+            let da = (pts[a].p[0] - v[0]).hypot(pts[a].p[1] - v[1]);
+            let db = (pts[b].p[0] - v[0]).hypot(pts[b].p[1] - v[1]);
+            da.total_cmp(&db)
+        })
+    };
+    let (Some(first), Some(last)) = (nearest(c.pts[0]), nearest(c.pts[n - 1])) else {
+        return false;
+    };
+    let (inner, outer, e) = if pts[last].d.abs() >= pts[first].d.abs() {
+        (c.pts[n - 2], c.pts[n - 1], &pts[last])
+    } else {
+        (c.pts[1], c.pts[0], &pts[first])
+    };
+    let u = [outer[0] - inner[0], outer[1] - inner[1]];
+    let nv = [e.p[0] - e.foot[0], e.p[1] - e.foot[1]];
+    let (lu, ln) = (u[0].hypot(u[1]), nv[0].hypot(nv[1]));
+    if lu <= 0.0 || ln <= 0.0 {
+        return false;
+    }
+    (u[0] * nv[0] + u[1] * nv[1]) / (lu * ln) >= min_deg.to_radians().sin()
 }
 
 /// Whether at least 3 in 4 of a cluster's points lie within `tol` of the line fitted to it
@@ -1252,5 +1289,34 @@ mod tests {
             ..QiuParams::default()
         };
         assert!(refine_by_continuity(&pts, &[], &off).is_empty());
+    }
+
+    /// A curb whose offset drifts 5 → 7 m over 25 m (the vehicle changes lanes, or the
+    /// road widens) spans more than `cluster_keep_spread_m` but never turns away from the
+    /// heading by `cluster_keep_turn_deg`: not kept whole. The same line turning out at
+    /// 40° at its end is.
+    #[test]
+    fn an_offset_drift_is_not_kept_as_an_arc() {
+        let drift = |turn: bool| {
+            let mut pts = Vec::new();
+            for k in 0..300 {
+                let x = k as f64 * 0.1;
+                let t = (x / 25.0).min(1.0);
+                let mut y = 5.0 + 1.0 - (std::f64::consts::PI * t).cos();
+                if turn && x > 25.0 {
+                    y += (x - 25.0) * 40f64.to_radians().tan();
+                }
+                pts.push(ep(x, y + if k % 2 == 0 { 0.02 } else { -0.02 }));
+            }
+            pts
+        };
+        let p = QiuParams::default();
+        assert!(refine_by_continuity(&drift(false), &[], &p).is_empty());
+        assert_eq!(refine_by_continuity(&drift(true), &[], &p).len(), 1);
+        let any_turn = QiuParams {
+            cluster_keep_turn_deg: 0.0,
+            ..QiuParams::default()
+        };
+        assert_eq!(refine_by_continuity(&drift(false), &[], &any_turn).len(), 1);
     }
 }
