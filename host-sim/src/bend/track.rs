@@ -87,21 +87,28 @@ pub fn track_edges(
             Side::Left => 1.0,
             Side::Right => -1.0,
         });
-        let mut one_way = |d: [f64; 3], up: f64| {
+        let mut one_way = |d: [f64; 3], up: f64, prior: usize| {
             track_one_way(
                 input,
                 grid,
                 &claims,
                 id,
                 seed.point,
+                prior,
                 d,
                 up,
                 &mut next_virtual,
                 params,
             )
         };
-        let (fwd, fwd_join) = one_way(dir, up_fwd);
-        let (bwd, bwd_join) = one_way([-dir[0], -dir[1], 0.0], -up_fwd);
+        let (mut fwd, mut fwd_join) = one_way(dir, up_fwd, 0);
+        let (bwd, bwd_join) = one_way([-dir[0], -dir[1], 0.0], -up_fwd, fwd.len());
+        // A seed just before a curb cut: forward, the track had too little curb behind it
+        // to follow the cut; with the curb tracked backwards it has.
+        if fwd_join.is_none() && fwd.len() < CUT_MIN_TRACK_STEPS && bwd.len() >= CUT_MIN_TRACK_STEPS
+        {
+            (fwd, fwd_join) = one_way(dir, up_fwd, bwd.len());
+        }
         let seed_xyz = [input.x[s], input.y[s], input.z[s]];
         let mut verts: Vec<(u32, [f64; 3])> = bwd.iter().rev().copied().collect();
         verts.push((seed.point, seed_xyz));
@@ -281,6 +288,8 @@ fn unit3(v: [f64; 3]) -> Option<[f64; 3]> {
 /// reached. Where S holds no point with ρ of at least the stop threshold, the toe is looked
 /// for on a virtual profile across the search direction ([`profile_toe`]; the curb rises
 /// on the side `up` of the direction: +1 left, −1 right) before the step counts as a gap.
+/// `prior_steps` counts the vertices the track already has behind `start` (the other
+/// direction's), which count towards [`CUT_MIN_TRACK_STEPS`].
 /// Returns the vertices picked (not including `start`) and the join, if any.
 #[allow(clippy::too_many_arguments)]
 fn track_one_way(
@@ -289,6 +298,7 @@ fn track_one_way(
     claims: &Claims,
     own: usize,
     start: u32,
+    prior_steps: usize,
     dir0: [f64; 3],
     up: f64,
     next_virtual: &mut u32,
@@ -372,7 +382,7 @@ fn track_one_way(
                 // break of slope, followed for at most `cut_follow_max_m`, and only by a
                 // track that has followed a curb before it.
                 let cut_ok = cut_run_m + d_s <= params.cut_follow_max_m
-                    && picked.len() >= CUT_MIN_TRACK_STEPS;
+                    && picked.len() + prior_steps >= CUT_MIN_TRACK_STEPS;
                 match toe {
                     Some(t) => {
                         cut_run_m = 0.0;
@@ -492,8 +502,8 @@ fn track_one_way(
                         let near = |t: &ProfileToe| {
                             (t.xyz[0] - p[0]).hypot(t.xyz[1] - p[1]) <= WEAK_CONFIRM_M
                         };
-                        let cut_ok =
-                            picked.len() >= CUT_MIN_TRACK_STEPS && params.cut_follow_max_m > 0.0;
+                        let cut_ok = picked.len() + prior_steps >= CUT_MIN_TRACK_STEPS
+                            && params.cut_follow_max_m > 0.0;
                         let confirmed = side_step(input, grid, n, along)
                             .is_some_and(|d| d * up >= WEAK_CONFIRM_STEP_M)
                             || profile_toe(input, grid, c, along, up, 2.0 * l, params)
@@ -575,6 +585,7 @@ mod tests {
     /// is 0.15 m up. ρ = 60° · |t_x| at the last road point before each rise along a
     /// scanline (t: the curb's unit tangent), so it fades as the corner turns to run along
     /// the scanlines, and is 0 on the side street, which no scanline crosses.
+    #[derive(Default)]
     struct Corner {
         x: Vec<f64>,
         y: Vec<f64>,
@@ -584,6 +595,19 @@ mod tests {
         status: Vec<Option<PointStatus>>,
         scanline: Vec<u32>,
         traj: Trajectory,
+    }
+
+    impl Corner {
+        /// Appends a kept point of scanline `line` at (x, y, z) with bend angle `rho`.
+        fn push(&mut self, x: f64, y: f64, z: f64, rho: f32, line: u32) {
+            self.x.push(x);
+            self.y.push(y);
+            self.z.push(z);
+            self.t.push(line as f64 * 0.01 + y * 1e-5);
+            self.rho.push(rho);
+            self.status.push(Some(PointStatus::Kept));
+            self.scanline.push(line);
+        }
     }
 
     fn sidewalk(x: f64, y: f64) -> bool {
@@ -603,16 +627,7 @@ mod tests {
     }
 
     fn corner() -> Corner {
-        let mut c = Corner {
-            x: Vec::new(),
-            y: Vec::new(),
-            z: Vec::new(),
-            t: Vec::new(),
-            rho: Vec::new(),
-            status: Vec::new(),
-            scanline: Vec::new(),
-            traj: Trajectory::default(),
-        };
+        let mut c = Corner::default();
         let mut line = 0u32;
         let mut x = 0.013;
         while x < 16.0 {
@@ -631,13 +646,7 @@ mod tests {
                 } else {
                     0.0
                 };
-                c.x.push(x);
-                c.y.push(y);
-                c.z.push(if up { 0.15 } else { 0.0 });
-                c.t.push(line as f64 * 0.01 + y * 1e-5);
-                c.rho.push(rho as f32);
-                c.status.push(Some(PointStatus::Kept));
-                c.scanline.push(line);
+                c.push(x, y, if up { 0.15 } else { 0.0 }, rho as f32, line);
                 y += 0.02;
             }
             x += 0.11;
@@ -662,11 +671,16 @@ mod tests {
 
     /// The track from a seed on the main curb at x ≈ 3.
     fn track(c: &Corner, params: &BendParams) -> Track {
+        track_from(c, params, 3.0)
+    }
+
+    /// The track from a seed on the main curb at x ≈ `x0`, driving towards +x.
+    fn track_from(c: &Corner, params: &BendParams, x0: f64) -> Track {
         let inp = input(c);
         let grid = PointGrid::build(inp.x, inp.y, 0.1, |_| true);
         let seed = (0..c.x.len())
             .filter(|&i| c.rho[i] > 10.0)
-            .min_by(|&a, &b| (c.x[a] - 3.0).abs().total_cmp(&(c.x[b] - 3.0).abs()))
+            .min_by(|&a, &b| (c.x[a] - x0).abs().total_cmp(&(c.x[b] - x0).abs()))
             .unwrap();
         let seeds = [Seed {
             point: seed as u32,
@@ -777,16 +791,7 @@ mod tests {
     /// flat. Along the line y = 5 every scanline has a point with ρ = `rho_curb` while
     /// the curb lasts and ρ = 15° (road noise above the stop threshold) after it.
     fn weak_line(curb_end: f64, rho_curb: f32) -> Corner {
-        let mut c = Corner {
-            x: Vec::new(),
-            y: Vec::new(),
-            z: Vec::new(),
-            t: Vec::new(),
-            rho: Vec::new(),
-            status: Vec::new(),
-            scanline: Vec::new(),
-            traj: Trajectory::default(),
-        };
+        let mut c = Corner::default();
         let mut line = 0u32;
         let mut x = 0.013;
         while x < 16.0 {
@@ -795,17 +800,12 @@ mod tests {
                 let y = k as f64 * 0.02;
                 let up = curb && y > 5.0;
                 let on_line = (y - 4.99).abs() < 0.01;
-                c.x.push(x);
-                c.y.push(y);
-                c.z.push(if up { 0.15 } else { 0.0 });
-                c.t.push(line as f64 * 0.01 + y * 1e-5);
-                c.rho.push(match (on_line, curb) {
+                let rho = match (on_line, curb) {
                     (false, _) => 0.0,
                     (true, true) => rho_curb,
                     (true, false) => 15.0,
-                });
-                c.status.push(Some(PointStatus::Kept));
-                c.scanline.push(line);
+                };
+                c.push(x, y, if up { 0.15 } else { 0.0 }, rho, line);
             }
             x += 0.11;
             line += 1;
@@ -841,6 +841,54 @@ mod tests {
         let low = weak_line(12.0, 15.0);
         let far_low = farthest_x(&low, &params);
         assert!((11.7..12.5).contains(&far_low), "weak curb: x = {far_low}");
+    }
+
+    /// A curb along y = 5 (sidewalk 0.15 m up beyond it, ρ = 60° on the toe line) with a
+    /// curb cut without lip from x = 7 to x = 11: there the ground behind y = 5 ramps up
+    /// at 20 % to the sidewalk and ρ is 0. Scanlines across x every 0.11 m, points every
+    /// 2 cm.
+    fn cut_line() -> Corner {
+        let mut c = Corner::default();
+        let mut line = 0u32;
+        let mut x = 0.013;
+        while x < 16.0 {
+            let cut = (7.0..11.0).contains(&x);
+            for k in 0..400 {
+                let y = k as f64 * 0.02;
+                let z = match (y > 5.0, cut) {
+                    (false, _) => 0.0,
+                    (true, false) => 0.15,
+                    (true, true) => (0.2 * (y - 5.0)).min(0.15),
+                };
+                let on_line = !cut && (y - 4.99).abs() < 0.01;
+                c.push(x, y, z, if on_line { 60.0 } else { 0.0 }, line);
+            }
+            x += 0.11;
+            line += 1;
+        }
+        c
+    }
+
+    #[test]
+    fn a_seed_just_before_a_cut_follows_it_with_the_curb_behind() {
+        // The seed lies 0.5 m before the cut, fewer than `CUT_MIN_TRACK_STEPS` steps: the
+        // 6.5 m of curb tracked backwards from it count, and the track crosses the cut on
+        // its toe to the curb beyond.
+        let c = cut_line();
+        let t = track_from(&c, &BendParams::default(), 6.5);
+        let far = t.xyz.iter().map(|q| q[0]).fold(f64::MIN, f64::max);
+        assert!(far > 15.0, "stopped at x = {far}");
+        for q in t.xyz.iter().filter(|q| (7.0..11.0).contains(&q[0])) {
+            assert!((q[1] - 5.0).abs() < 0.06, "vertex {q:?} off the cut's toe");
+        }
+        // Without cut following the track ends where the curb does.
+        let off = BendParams {
+            cut_follow_max_m: 0.0,
+            ..BendParams::default()
+        };
+        let t0 = track_from(&c, &off, 6.5);
+        let far0 = t0.xyz.iter().map(|q| q[0]).fold(f64::MIN, f64::max);
+        assert!(far0 < 8.5, "without cut following: x = {far0}");
     }
 
     #[test]
