@@ -1,7 +1,11 @@
-//! Two scanners in an X on a few seconds of kawasaki (a parked car at the left curb):
-//! `simulate --scanners 2` writes one file of two channels; extract reads both by default,
-//! each through its own core and tracker, and fuses them into one edge per curb that
-//! covers at least what either scanner alone covers, with no parallel copies.
+//! One edge per curb from several observations of it, end to end on a few seconds of
+//! kawasaki (a parked car at the left curb):
+//! - two scanners in an X: `simulate --scanners 2` writes one file of two channels; extract
+//!   reads both by default, each through its own core and tracker, and fuses them into one
+//!   edge per curb that covers at least what either scanner alone covers;
+//! - two passes: `simulate --passes 2` drives the street back with a GNSS offset; extract
+//!   finds the passes from the trajectory, turns and shifts the second onto the first and
+//!   fuses them, with no parallel copies and at least the better pass's quality.
 
 use curbtrace_host_sim::config::Config;
 use curbtrace_host_sim::eval::{evaluate, EvalParams};
@@ -107,6 +111,55 @@ fn two_scanners_fused_cover_what_either_covers_once() {
     assert!(cf >= c0.max(c1), "fused C {cf} < single {c0} / {c1}");
     assert!(pf >= p0.min(p1) - 1.0, "fused P {pf} vs {p0} / {p1}");
     // One edge per curb: no parallel copies.
+    let d = doubled_m(&fused);
+    assert!(d < 0.5, "{d} m of fused toe beside another stretch");
+}
+
+#[test]
+fn two_passes_fused_give_one_edge_per_curb_at_least_as_good_as_either() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut spec = curbtrace_host_sim::simulate::scene_by_name("kawasaki").unwrap();
+    spec.drive = (56.0, 90.0);
+    let s =
+        curbtrace_host_sim::simulate::passes::run_passes(&spec, 5, None, 0.1, dir.path(), false)
+            .unwrap();
+    let (reference, _) = read_geojson(&s.reference_path).unwrap();
+    let run = |pass: Option<u16>| {
+        let opts = ExtractOptions {
+            pass,
+            ..ExtractOptions::default()
+        };
+        stream::extract(
+            std::slice::from_ref(&s.points_path),
+            &s.trajectory_path,
+            &Config::default(),
+            &opts,
+            &WindowParams::default(),
+            &Progress::hidden(),
+        )
+        .unwrap()
+        .edges
+    };
+    let quality = |edges: &[EdgeLine]| {
+        evaluate(&reference, edges, &EvalParams::default())
+            .unwrap()
+            .total
+            .quality_pct
+            .unwrap()
+    };
+    let (p0, p1, fused) = (run(Some(0)), run(Some(1)), run(None));
+    let (q0, q1, qf) = (quality(&p0), quality(&p1), quality(&fused));
+    eprintln!("pass 0 Q {q0:.1}; pass 1 Q {q1:.1}; fused Q {qf:.1}");
+    // Both passes placed stretches of the fused edges, and the fused edges score at least
+    // what the better pass alone does (pass 1 alone still carries its 0.1 m offset).
+    let mut named: Vec<u16> = fused
+        .iter()
+        .flat_map(|e| e.detail.as_ref().unwrap().passes())
+        .collect();
+    named.sort_unstable();
+    named.dedup();
+    assert_eq!(named, vec![0, 1]);
+    assert!(qf >= q0.max(q1), "fused Q {qf} < single pass {q0} / {q1}");
     let d = doubled_m(&fused);
     assert!(d < 0.5, "{d} m of fused toe beside another stretch");
 }
