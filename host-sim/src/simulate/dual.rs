@@ -17,7 +17,7 @@
 use super::reference::{self, Visibility};
 use super::scanner::{self, Return, ScannerConfig, VehicleBody};
 use super::{line_seed, simulate, SceneSpec, SimError, SimSummary, Simulation};
-use crate::model::{Crs, EdgeLine};
+use crate::model::EdgeLine;
 use crate::mounts::{Mount, Mounts};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -210,23 +210,13 @@ pub fn run_two(
         two.mounts.to_toml()
     );
     std::fs::write(&mounts_path, text).map_err(io_err(&mounts_path))?;
-    let crs = super::write::wkt_for(spec.epsg)
-        .map(Crs::Wkt)
-        .unwrap_or(Crs::Epsg(spec.epsg));
-    let each = [
-        out_dir.join("reference_scanner0.geojson"),
-        out_dir.join("reference_scanner1.geojson"),
-    ];
-    for (path, lines) in [(&reference_path, &sim.reference)]
+    let crs = super::write::crs_for(spec.epsg);
+    super::write::write_reference(&reference_path, &sim.reference, &crs)?;
+    for (name, lines) in ["reference_scanner0.geojson", "reference_scanner1.geojson"]
         .into_iter()
-        .chain(each.iter().zip(&two.reference_each))
+        .zip(&two.reference_each)
     {
-        crate::output::geojson::write_geojson(path, lines, Some(&crs)).map_err(|e| {
-            SimError::Write {
-                path: path.display().to_string(),
-                what: e.to_string(),
-            }
-        })?;
+        super::write::write_reference(&out_dir.join(name), lines, &crs)?;
     }
     Ok(SimSummary::of(
         spec,

@@ -427,17 +427,8 @@ pub fn run_with(
     let ring = spin.and_then(|s| s.ring_name);
     write::write_points_with(&points_path, &sim.returns, origin, spec.epsg, ring)?;
     write::write_trajectory(&trajectory_path, &sim.traj, origin)?;
-    // The same CRS text as the LAS file's WKT VLR, so that readers deriving the CRS from
-    // the points and from the reference get identical values.
-    let crs = write::wkt_for(spec.epsg)
-        .map(Crs::Wkt)
-        .unwrap_or(Crs::Epsg(spec.epsg));
-    crate::output::geojson::write_geojson(&reference_path, &sim.reference, Some(&crs)).map_err(
-        |e| SimError::Write {
-            path: reference_path.display().to_string(),
-            what: e.to_string(),
-        },
-    )?;
+    let crs = write::crs_for(spec.epsg);
+    write::write_reference(&reference_path, &sim.reference, &crs)?;
     Ok(SimSummary::of(
         spec,
         &sim,

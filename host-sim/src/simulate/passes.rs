@@ -18,7 +18,7 @@ use super::reference::{self, Visibility};
 use super::scanner::Return;
 use super::{cast_drive, drive, simulate, SceneSpec, SimError, SimSummary, Simulation};
 use crate::io::trajectory::Trajectory;
-use crate::model::{Crs, EdgeLine};
+use crate::model::EdgeLine;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;
@@ -130,23 +130,13 @@ pub fn run_passes(
     let reference_path = out_dir.join("reference.geojson");
     super::write::write_points_with(&points_path, &sim.returns, origin, spec.epsg, None)?;
     super::write::write_trajectory(&trajectory_path, &sim.traj, origin)?;
-    let crs = super::write::wkt_for(spec.epsg)
-        .map(Crs::Wkt)
-        .unwrap_or(Crs::Epsg(spec.epsg));
-    let each = [
-        out_dir.join("reference_pass0.geojson"),
-        out_dir.join("reference_pass1.geojson"),
-    ];
-    for (path, lines) in [(&reference_path, &sim.reference)]
+    let crs = super::write::crs_for(spec.epsg);
+    super::write::write_reference(&reference_path, &sim.reference, &crs)?;
+    for (name, lines) in ["reference_pass0.geojson", "reference_pass1.geojson"]
         .into_iter()
-        .chain(each.iter().zip(&two.reference_each))
+        .zip(&two.reference_each)
     {
-        crate::output::geojson::write_geojson(path, lines, Some(&crs)).map_err(|e| {
-            SimError::Write {
-                path: path.display().to_string(),
-                what: e.to_string(),
-            }
-        })?;
+        super::write::write_reference(&out_dir.join(name), lines, &crs)?;
     }
     Ok(SimSummary::of(
         spec,

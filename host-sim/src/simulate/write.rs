@@ -4,6 +4,7 @@
 use super::scanner::Return;
 use super::SimError;
 use crate::io::trajectory::Trajectory;
+use crate::model::{Crs, EdgeLine};
 use std::io::Write;
 use std::path::Path;
 
@@ -156,6 +157,20 @@ pub fn write_points_channels(
     }
     w.close().map_err(err)?;
     Ok(())
+}
+
+/// The CRS of a simulation's outputs: the same text as the LAS file's WKT VLR, so that
+/// readers deriving the CRS from the points and from a reference get identical values.
+pub fn crs_for(epsg: u32) -> Crs {
+    wkt_for(epsg).map(Crs::Wkt).unwrap_or(Crs::Epsg(epsg))
+}
+
+/// Writes reference lines to `path` as GeoJSON in `crs`.
+pub fn write_reference(path: &Path, lines: &[EdgeLine], crs: &Crs) -> Result<(), SimError> {
+    crate::output::geojson::write_geojson(path, lines, Some(crs)).map_err(|e| SimError::Write {
+        path: path.display().to_string(),
+        what: e.to_string(),
+    })
 }
 
 /// Writes `time,x,y,z,roll,pitch,heading` (docs/spec.md §3), positions + `origin`.
