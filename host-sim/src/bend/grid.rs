@@ -26,6 +26,23 @@ impl PointGrid {
     /// `keep` is asked once per point; the answers are kept as a bitmap (one bit per point)
     /// for the two passes of the counting sort.
     pub fn build(x: &[f64], y: &[f64], cell_m: f64, keep: impl Fn(usize) -> bool) -> Self {
+        let mut g = Self {
+            cell_m: 1.0,
+            x0: 0.0,
+            y0: 0.0,
+            nx: 0,
+            ny: 0,
+            starts: Vec::new(),
+            order: Vec::new(),
+        };
+        g.rebuild(x, y, cell_m, keep);
+        g
+    }
+
+    /// [`build`](Self::build) in place: the same index, in the cell and order arrays this
+    /// grid already holds. A stream builds a grid for every section; reusing the arrays
+    /// spares the kernel mapping and zeroing fresh pages for them each time.
+    pub fn rebuild(&mut self, x: &[f64], y: &[f64], cell_m: f64, keep: impl Fn(usize) -> bool) {
         let n = x.len().min(y.len()).min(u32::MAX as usize - 1);
         let (x, y) = (&x[..n], &y[..n]);
         let mut kept = vec![0u64; n.div_ceil(64)];
@@ -51,16 +68,13 @@ impl PointGrid {
         } else {
             1.0
         };
+        self.starts.clear();
+        self.order.clear();
         if count == 0 {
-            return Self {
-                cell_m: cell,
-                x0: 0.0,
-                y0: 0.0,
-                nx: 0,
-                ny: 0,
-                starts: vec![0],
-                order: Vec::new(),
-            };
+            self.cell_m = cell;
+            (self.x0, self.y0, self.nx, self.ny) = (0.0, 0.0, 0, 0);
+            self.starts.push(0);
+            return;
         }
         let max_cells = (count / 2).max(1024) as f64;
         let dims = |c: f64| (((x1 - x0) / c).floor() + 1.0, ((y1 - y0) / c).floor() + 1.0);
@@ -72,37 +86,34 @@ impl PointGrid {
         }
         let (a, b) = dims(cell);
         let (nx, ny) = (a as usize, b as usize);
-        let mut g = Self {
-            cell_m: cell,
-            x0,
-            y0,
-            nx,
-            ny,
-            starts: vec![0u32; nx * ny + 1],
-            order: Vec::new(),
-        };
+        (self.cell_m, self.x0, self.y0, self.nx, self.ny) = (cell, x0, y0, nx, ny);
+        self.starts.resize(nx * ny + 1, 0);
         // Each kept point's cell, found once for the count and kept for the scatter (4
         // bytes a kept point while the grid is built).
-        let cells = CellOf::new(&g);
+        let cells = CellOf::new(self);
+        let starts = &mut self.starts;
         let mut cell_of = Vec::with_capacity(count);
         for_each_set(&kept, |i| {
             let c = cells.at(x[i], y[i]);
-            g.starts[c + 1] += 1;
+            starts[c + 1] += 1;
             cell_of.push(c as u32);
         });
+        // Prefix sums: `starts[c + 1]` is where cell c + 1 begins. The scatter moves each
+        // cell's start on to its end; one shift back gives the starts again.
         for c in 0..nx * ny {
-            g.starts[c + 1] += g.starts[c];
+            starts[c + 1] += starts[c];
         }
-        let mut fill = g.starts.clone();
-        g.order = vec![0u32; count];
+        self.order.resize(count, 0);
+        let order = &mut self.order;
         let mut k = 0;
         for_each_set(&kept, |i| {
             let c = cell_of[k] as usize;
             k += 1;
-            g.order[fill[c] as usize] = i as u32;
-            fill[c] += 1;
+            order[starts[c] as usize] = i as u32;
+            starts[c] += 1;
         });
-        g
+        starts.copy_within(0..nx * ny, 1);
+        starts[0] = 0;
     }
 
     /// Calls `f(i)` for every indexed point within `r` (horizontal) of `(px, py)`, in a
@@ -348,6 +359,42 @@ mod tests {
         }
         assert!(floor(f64::NAN).is_nan());
         assert_eq!(floor(f64::NEG_INFINITY), f64::NEG_INFINITY);
+    }
+
+    #[test]
+    fn a_rebuilt_grid_is_the_grid_built_afresh() {
+        // One grid rebuilt over clouds larger, smaller and empty in turn answers every
+        // query as a grid built for that cloud alone, in the same order.
+        let cloud = |n: u32, seed: u32| -> (Vec<f64>, Vec<f64>) {
+            let x = (0..n)
+                .map(|k| 600_000.0 + f64::from(k.wrapping_mul(seed) % 4_001) * 1e-3)
+                .collect();
+            let y = (0..n)
+                .map(|k| 4_000_000.0 + f64::from(k.wrapping_mul(40_503 ^ seed) % 2_999) * 1e-3)
+                .collect();
+            (x, y)
+        };
+        let mut g = PointGrid::build(&[], &[], 0.1, |_| true);
+        for (n, seed) in [(5_000, 2_654_435_761), (700, 97), (0, 1), (12_000, 31_337)] {
+            let (x, y) = cloud(n, seed);
+            let keep = |i: usize| i % 5 != 2;
+            g.rebuild(&x, &y, 0.1, keep);
+            let fresh = PointGrid::build(&x, &y, 0.1, keep);
+            assert_eq!(g.len(), fresh.len());
+            assert_eq!(g.cell_m(), fresh.cell_m());
+            for q in 0..20u32 {
+                let (px, py) = (
+                    600_000.0 + f64::from(q) * 0.2,
+                    4_000_000.0 + f64::from(q % 7) * 0.4,
+                );
+                let (mut a, mut b) = (Vec::new(), Vec::new());
+                g.for_each_within(&x, &y, px, py, 0.3, |i| a.push(i));
+                fresh.for_each_within(&x, &y, px, py, 0.3, |i| b.push(i));
+                assert_eq!(a, b);
+                assert!(a.iter().all(|&i| keep(i)));
+                assert!(n < 5_000 || !a.is_empty());
+            }
+        }
     }
 
     #[test]

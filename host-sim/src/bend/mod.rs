@@ -111,9 +111,17 @@ pub fn extract_edges_on_route(
 /// cross-sections of [`crate::curb::annotate`] read all. Cells of the search radius
 /// (5 cm to 1 m).
 pub fn point_grid(input: &BendInput, params: &BendParams) -> grid::PointGrid {
+    let mut g = grid::PointGrid::build(&[], &[], 1.0, |_| false);
+    point_grid_into(&mut g, input, params);
+    g
+}
+
+/// [`point_grid`] built in `grid`'s arrays (a stream's window reuses one grid for every
+/// section).
+pub fn point_grid_into(grid: &mut grid::PointGrid, input: &BendInput, params: &BendParams) {
     let input = input.truncated();
     let cell_m = params.search_radius_m.clamp(0.05, 1.0);
-    grid::PointGrid::build(input.x, input.y, cell_m, |i| input.status[i].is_some())
+    grid.rebuild(input.x, input.y, cell_m, |i| input.status[i].is_some());
 }
 
 /// [`extract_edges_on_route`] on `grid`, the [`point_grid`] of `input`.

@@ -172,8 +172,29 @@ fn gather(
             }
         },
     );
-    prof.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
-    prof
+    sort_across(prof)
+}
+
+/// `prof` sorted by `across`, then height, by `total_cmp`, points equal in both kept in
+/// the order they came in: the order of a stable sort, found by an unstable sort of
+/// integer keys (each float's bits mapped so that unsigned order is `total_cmp`'s, then
+/// the point's place), which is cheaper than comparing the floats.
+fn sort_across(prof: Vec<(f64, f64, f64)>) -> Vec<(f64, f64, f64)> {
+    let ordered = |v: f64| {
+        let b = v.to_bits();
+        if b >> 63 == 1 {
+            !b
+        } else {
+            b | 1 << 63
+        }
+    };
+    let mut keys: Vec<(u64, u64, u32)> = prof
+        .iter()
+        .enumerate()
+        .map(|(k, p)| (ordered(p.0), ordered(p.1), k as u32))
+        .collect();
+    keys.sort_unstable();
+    keys.iter().map(|k| prof[k.2 as usize]).collect()
 }
 
 /// Prefix sums of 1, c, c², z, c·z, z² over a sorted profile (heights relative to the
@@ -322,4 +343,36 @@ pub fn cut_toe(
         ],
         step_m: step.max(0.0),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sort_across_is_the_stable_sort_by_total_cmp() {
+        // Positions and heights on a coarse lattice (many exact ties, ±0, a NaN), the third
+        // value telling the points apart: ties must keep their order of arrival.
+        let mut prof = Vec::new();
+        for k in 0..2_000u32 {
+            let c = f64::from(k.wrapping_mul(2_654_435_761) % 41) * 0.025 - 0.5;
+            let z = f64::from(k.wrapping_mul(40_503) % 7) * 0.01 - 0.03;
+            prof.push((c, z, f64::from(k)));
+        }
+        prof.push((-0.0, 0.0, -1.0));
+        prof.push((0.0, -0.0, -2.0));
+        prof.push((f64::NAN, 0.0, -3.0));
+        prof.push((-1e-300, f64::INFINITY, -4.0));
+        let mut want = prof.clone();
+        want.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
+        let got = sort_across(prof);
+        let bits = |v: &[(f64, f64, f64)]| -> Vec<[u64; 3]> {
+            v.iter()
+                .map(|p| [p.0.to_bits(), p.1.to_bits(), p.2.to_bits()])
+                .collect()
+        };
+        assert_eq!(bits(&got), bits(&want));
+        // Ties there were, and they are in arrival order.
+        assert!(got.windows(2).any(|w| w[0].0 == w[1].0 && w[0].1 == w[1].1));
+    }
 }

@@ -17,6 +17,7 @@
 
 use super::core_stage::CoreBatch;
 use super::merge::{Merge, Piece};
+use crate::bend::grid::PointGrid;
 use crate::bend::route::Route;
 use crate::bend::{self, BendInput, BendParams};
 use crate::curb;
@@ -147,6 +148,8 @@ pub struct SectionWindow<'a> {
     pub peak_points: usize,
     /// Points dropped by the time cap (`max_s`).
     pub capped_points: u64,
+    /// The point grid of the section last run, rebuilt in place for the next.
+    grid: PointGrid,
 }
 
 /// Least progress along the route, metres, for which the time cap closes a section early;
@@ -168,6 +171,7 @@ impl<'a> SectionWindow<'a> {
             kept: Vec::new(),
             peak_points: 0,
             capped_points: 0,
+            grid: PointGrid::build(&[], &[], 1.0, |_| false),
         }
     }
 
@@ -310,7 +314,7 @@ impl<'a> SectionWindow<'a> {
     }
 
     /// The bend method on the window's points `lo..hi`.
-    fn extract_range(&self, lo: usize, hi: usize) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
+    fn extract_range(&mut self, lo: usize, hi: usize) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
         let c = &self.cols;
         let (glo, ghi) = (c.base + lo as u64, c.base + hi as u64);
         let cands: Vec<Candidate> = c
@@ -334,9 +338,10 @@ impl<'a> SectionWindow<'a> {
             trajectory: self.traj,
         };
         // One index for the tracker and the curb annotation.
-        let grid = bend::point_grid(&input, &self.bend);
-        let mut edges = bend::extract_edges_on_grid(&input, &grid, &self.route, &self.bend);
-        curb::annotate(&input, &grid, &self.route, edges.iter_mut().map(|(e, _)| e));
+        bend::point_grid_into(&mut self.grid, &input, &self.bend);
+        let grid = &self.grid;
+        let mut edges = bend::extract_edges_on_grid(&input, grid, &self.route, &self.bend);
+        curb::annotate(&input, grid, &self.route, edges.iter_mut().map(|(e, _)| e));
         edges
     }
 }
