@@ -262,6 +262,79 @@ const WEAK_CONFIRM_M: f64 = 0.1;
 /// above a road's crossfall over that width.
 const WEAK_CONFIRM_STEP_M: f64 = 0.03;
 
+/// Length of track, metres, back from its end over which [`line_ahead`] fits the curb
+/// line a cut's toe is sought along: long enough to average the ±0.1 m scatter of cut toes
+/// out, short enough that a 30 m radius leaves the line by under 2 cm at its end.
+const CUT_LINE_M: f64 = 2.0;
+
+/// Fewest vertices, and shortest span in metres, of the fit of [`line_ahead`].
+const CUT_LINE_MIN_VERTS: usize = 6;
+const CUT_LINE_MIN_SPAN_M: f64 = 1.0;
+
+/// The curb line a track follows into a cut: the least-squares line (orthogonal
+/// distances, horizontal) through its vertices over the last [`CUT_LINE_M`] from `cur`,
+/// oriented along `along`. Returns the point `d_s` past the foot of `cur` on that line,
+/// and the line's unit direction; `None` when the track is too short for a fit or the
+/// line turns more than 45° from `along`.
+///
+/// Eq. 8 turns the search direction towards every new vertex; the toes of a low-lip cut
+/// scatter by up to ±0.1 m across the line over 0.15 m steps, so a track that follows
+/// them walks towards the ramp behind, whose top is the next break of slope. The fitted
+/// line does not follow one toe's scatter, and a cut keeps the line of the curb it
+/// interrupts.
+fn line_ahead(
+    picked: &[(u32, [f64; 3])],
+    cur: [f64; 3],
+    along: [f64; 2],
+    d_s: f64,
+) -> Option<([f64; 2], [f64; 2])> {
+    let pts: Vec<[f64; 2]> = picked
+        .iter()
+        .rev()
+        .map(|v| [v.1[0], v.1[1]])
+        .take_while(|p| (p[0] - cur[0]).hypot(p[1] - cur[1]) <= CUT_LINE_M)
+        .collect();
+    if pts.len() < CUT_LINE_MIN_VERTS {
+        return None;
+    }
+    let far = pts
+        .iter()
+        .map(|p| (p[0] - cur[0]).hypot(p[1] - cur[1]))
+        .fold(0.0, f64::max);
+    if far < CUT_LINE_MIN_SPAN_M {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let mx = pts.iter().map(|p| p[0]).sum::<f64>() / n;
+    let my = pts.iter().map(|p| p[1]).sum::<f64>() / n;
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for p in &pts {
+        let (dx, dy) = (p[0] - mx, p[1] - my);
+        sxx += dx * dx;
+        sxy += dx * dy;
+        syy += dy * dy;
+    }
+    // Principal axis of the 2×2 scatter matrix.
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let mut a = [theta.cos(), theta.sin()];
+    let dot = a[0] * along[0] + a[1] * along[1];
+    if dot < 0.0 {
+        a = [-a[0], -a[1]];
+    }
+    if dot.abs() < std::f64::consts::FRAC_1_SQRT_2 {
+        return None;
+    }
+    let s = (cur[0] - mx) * a[0] + (cur[1] - my) * a[1] + d_s;
+    Some(([mx + s * a[0], my + s * a[1]], a))
+}
+
+/// `v` (a unit vector) turned to the horizontal heading `a` (a unit vector), keeping its
+/// vertical component.
+fn with_heading(v: [f64; 3], a: [f64; 2]) -> [f64; 3] {
+    let h = (1.0 - v[2] * v[2]).max(0.0).sqrt();
+    [a[0] * h, a[1] * h, v[2]]
+}
+
 /// Largest vertical component of the search direction (a grade of about 15 %).
 const MAX_CLIMB: f64 = 0.15;
 
@@ -330,6 +403,9 @@ fn track_one_way(
     let mut weak_from: Option<usize> = None;
 
     for _ in 0..params.max_steps {
+        // Horizontal direction of the curb line this step's cut toe is found along, if
+        // any: it replaces the direction of the step to that toe (see [`line_ahead`]).
+        let mut cut_dir: Option<[f64; 2]> = None;
         // The search position (Fig. 7): one search distance ahead along v.
         let pred = [
             cur[0] + d_s * v[0],
@@ -390,10 +466,15 @@ fn track_one_way(
                         Some(t)
                     }
                     None if cut_ok => {
-                        let t = cut_toe(input, grid, c, along, up, 2.0 * l, params);
+                        // The cut's toe is sought on the line of the track's last metres,
+                        // not one step along v: v follows the scatter of the toes before.
+                        let line = line_ahead(&picked, cur, along, d_s);
+                        let (cc, ca) = line.map_or((c, along), |(p, a)| ([p[0], p[1], cur[2]], a));
+                        let t = cut_toe(input, grid, cc, ca, up, 2.0 * l, params);
                         if t.is_some() {
                             cut_run_m += d_s;
                             cut_from.get_or_insert(picked.len());
+                            cut_dir = line.map(|(_, a)| a);
                         }
                         t
                     }
@@ -549,6 +630,12 @@ fn track_one_way(
         // curb face, and would lift the search position off the ground within a few gap
         // steps.
         let v_new = clamp_climb(v_new);
+        // On a cut's toe the direction is the fitted line's, and so is the last difference
+        // vector's: one toe's scatter across the line does not turn the search.
+        let (v_new, u) = match cut_dir {
+            Some(a) => (with_heading(v_new, a), with_heading(u, a)),
+            None => (v_new, u),
+        };
         if gap == 0 {
             let dturn =
                 (v[0] * v_new[1] - v[1] * v_new[0]).atan2(v[0] * v_new[0] + v[1] * v_new[1]);
