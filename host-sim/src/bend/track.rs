@@ -1037,12 +1037,13 @@ mod tests {
             .collect();
         let cur = picked.last().unwrap().1;
         let (p, a) = line_ahead(&picked, cur, [1.0, 0.0], 0.15).expect("a line");
-        // On the line (not 0.08 m off it, where the last toe is), 0.15 m past that toe.
+        // Near the line (not 0.08 m off it, where the last toe is; the alternation
+        // itself tilts the fit by about 1°), 0.15 m past that toe.
         let across = p[0] * n[0] + p[1] * n[1];
         let along = p[0] * t[0] + p[1] * t[1];
-        assert!(across.abs() < 0.01, "{across}");
+        assert!(across.abs() < 0.03, "{across}");
         assert!((along - (19.0 * 0.15 + 0.15)).abs() < 0.01, "{along}");
-        assert!((a[0] * t[0] + a[1] * t[1]) > 0.9999, "{a:?}");
+        assert!((a[0] * t[0] + a[1] * t[1]) > 0.999, "{a:?}");
         // Oriented along the search direction given, and refused across it.
         let (_, back) = line_ahead(&picked, cur, [-1.0, 0.0], 0.15).unwrap();
         assert!(back[0] < 0.0);
