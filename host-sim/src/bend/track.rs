@@ -262,6 +262,106 @@ const WEAK_CONFIRM_M: f64 = 0.1;
 /// above a road's crossfall over that width.
 const WEAK_CONFIRM_STEP_M: f64 = 0.03;
 
+/// Length of track, metres, back from its end over which [`line_ahead`] fits the curb
+/// line a cut's toe is sought along: long enough to average the ±0.1 m scatter of cut toes
+/// out, short enough that a 30 m radius leaves the line by under 2 cm at its end.
+const CUT_LINE_M: f64 = 2.0;
+
+/// Fewest vertices, and shortest span in metres, of the fit of [`line_ahead`].
+const CUT_LINE_MIN_VERTS: usize = 6;
+const CUT_LINE_MIN_SPAN_M: f64 = 1.0;
+
+/// The curb line a track follows into a cut: the least-squares line (orthogonal
+/// distances, horizontal) through its vertices over the last [`CUT_LINE_M`] from `cur`,
+/// oriented along `along`. Returns the point `d_s` past the foot of `cur` on that line,
+/// and the line's unit direction; `None` when the track is too short for a fit or the
+/// line turns more than 45° from `along`.
+///
+/// Eq. 8 turns the search direction towards every new vertex; the toes of a low-lip cut
+/// scatter by up to ±0.1 m across the line over 0.15 m steps, so a track that follows
+/// them walks towards the ramp behind, whose top is the next break of slope. The fitted
+/// line does not follow one toe's scatter, and a cut keeps the line of the curb it
+/// interrupts.
+fn line_ahead(
+    picked: &[(u32, [f64; 3])],
+    cur: [f64; 3],
+    along: [f64; 2],
+    d_s: f64,
+) -> Option<([f64; 2], [f64; 2])> {
+    let pts: Vec<[f64; 2]> = picked
+        .iter()
+        .rev()
+        .map(|v| [v.1[0], v.1[1]])
+        .take_while(|p| (p[0] - cur[0]).hypot(p[1] - cur[1]) <= CUT_LINE_M)
+        .collect();
+    if pts.len() < CUT_LINE_MIN_VERTS {
+        return None;
+    }
+    let far = pts
+        .iter()
+        .map(|p| (p[0] - cur[0]).hypot(p[1] - cur[1]))
+        .fold(0.0, f64::max);
+    if far < CUT_LINE_MIN_SPAN_M {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let mx = pts.iter().map(|p| p[0]).sum::<f64>() / n;
+    let my = pts.iter().map(|p| p[1]).sum::<f64>() / n;
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for p in &pts {
+        let (dx, dy) = (p[0] - mx, p[1] - my);
+        sxx += dx * dx;
+        sxy += dx * dy;
+        syy += dy * dy;
+    }
+    // Principal axis of the 2×2 scatter matrix.
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let mut a = [theta.cos(), theta.sin()];
+    let dot = a[0] * along[0] + a[1] * along[1];
+    if dot < 0.0 {
+        a = [-a[0], -a[1]];
+    }
+    if dot.abs() < std::f64::consts::FRAC_1_SQRT_2 {
+        return None;
+    }
+    let s = (cur[0] - mx) * a[0] + (cur[1] - my) * a[1] + d_s;
+    Some(([mx + s * a[0], my + s * a[1]], a))
+}
+
+/// The toe of the curb cut a track is following (`cut` = (length followed, index of its
+/// first vertex), the latter `None` when the last vertex is no cut toe), sought on the
+/// line of the track's last metres ([`line_ahead`]) and ahead of `cur`, with that line's
+/// direction; `None` off a cut, past `cut_follow_max_m`, or where the profile shows no
+/// cut toe.
+#[allow(clippy::too_many_arguments)]
+fn cut_on_line(
+    input: &BendInput,
+    grid: &PointGrid,
+    picked: &[(u32, [f64; 3])],
+    cur: [f64; 3],
+    along: [f64; 2],
+    up: f64,
+    cut: (f64, Option<usize>),
+    params: &BendParams,
+) -> Option<(ProfileToe, [f64; 2])> {
+    let d_s = params.search_distance_m;
+    if cut.1.is_none() || cut.0 + d_s > params.cut_follow_max_m || !params.profile_fallback {
+        return None;
+    }
+    let (q, a) = line_ahead(picked, cur, along, d_s)?;
+    let l = 2.0 * params.profile_half_length_m;
+    let toe = cut_toe(input, grid, [q[0], q[1], cur[2]], a, up, l, params)?;
+    let ahead = (toe.xyz[0] - cur[0]) * along[0] + (toe.xyz[1] - cur[1]) * along[1];
+    (ahead > 0.25 * d_s).then_some((toe, a))
+}
+
+/// `v` (a unit vector) turned to the horizontal heading `a` (a unit vector), keeping its
+/// vertical component.
+fn with_heading(v: [f64; 3], a: [f64; 2]) -> [f64; 3] {
+    let h = (1.0 - v[2] * v[2]).max(0.0).sqrt();
+    [a[0] * h, a[1] * h, v[2]]
+}
+
 /// Largest vertical component of the search direction (a grade of about 15 %).
 const MAX_CLIMB: f64 = 0.15;
 
@@ -330,6 +430,9 @@ fn track_one_way(
     let mut weak_from: Option<usize> = None;
 
     for _ in 0..params.max_steps {
+        // Horizontal direction of the curb line this step's cut toe is found along, if
+        // any: it replaces the direction of the step to that toe (see [`line_ahead`]).
+        let mut cut_dir: Option<[f64; 2]> = None;
         // The search position (Fig. 7): one search distance ahead along v.
         let pred = [
             cur[0] + d_s * v[0],
@@ -390,10 +493,15 @@ fn track_one_way(
                         Some(t)
                     }
                     None if cut_ok => {
-                        let t = cut_toe(input, grid, c, along, up, 2.0 * l, params);
+                        // The cut's toe is sought on the line of the track's last metres,
+                        // not one step along v: v follows the scatter of the toes before.
+                        let line = line_ahead(&picked, cur, along, d_s);
+                        let (cc, ca) = line.map_or((c, along), |(p, a)| ([p[0], p[1], cur[2]], a));
+                        let t = cut_toe(input, grid, cc, ca, up, 2.0 * l, params);
                         if t.is_some() {
                             cut_run_m += d_s;
                             cut_from.get_or_insert(picked.len());
+                            cut_dir = line.map(|(_, a)| a);
                         }
                         t
                     }
@@ -466,6 +574,7 @@ fn track_one_way(
                 }
             }
             let Some((_, n)) = best else { break };
+            let cut_before = (cut_run_m, cut_from);
             cut_run_m = 0.0;
             cut_from = None;
             // Consecutive toes lie at nearly one height; a pick well above or below the
@@ -492,42 +601,58 @@ fn track_one_way(
                     (id, toe.xyz)
                 }
                 None => {
-                    // A weak pick counts as the curb only where the ground steps up beside it
-                    // or a virtual profile shows a toe there; otherwise it adds to the
-                    // unconfirmed stretch.
                     let p = [input.x[n], input.y[n], input.z[n]];
-                    if (input.rho_deg[n] as f64) < params.weak_rho_deg
-                        && params.weak_run_max_m > 0.0
-                    {
-                        let near = |t: &ProfileToe| {
-                            (t.xyz[0] - p[0]).hypot(t.xyz[1] - p[1]) <= WEAK_CONFIRM_M
-                        };
-                        let cut_ok = picked.len() + prior_steps >= CUT_MIN_TRACK_STEPS
-                            && params.cut_follow_max_m > 0.0;
-                        let confirmed = side_step(input, grid, n, along)
-                            .is_some_and(|d| d * up >= WEAK_CONFIRM_STEP_M)
-                            || profile_toe(input, grid, c, along, up, 2.0 * l, params)
-                                .filter(near)
-                                .is_some()
-                            || (cut_ok
-                                && cut_toe(input, grid, c, along, up, 2.0 * l, params)
-                                    .filter(near)
-                                    .is_some());
-                        if confirmed {
-                            weak_run_m = 0.0;
-                            weak_from = None;
-                        } else {
-                            weak_run_m += (p[0] - cur[0]).hypot(p[1] - cur[1]);
-                            weak_from.get_or_insert(picked.len());
-                            if weak_run_m > params.weak_run_max_m {
-                                break;
-                            }
-                        }
+                    let weak = (input.rho_deg[n] as f64) < params.weak_rho_deg;
+                    // On a cut, a weak pick is road noise beside the toe: the cut's toe on
+                    // the track's line is taken instead where there is one.
+                    let on_line = if weak {
+                        cut_on_line(input, grid, &picked, cur, along, up, cut_before, params)
                     } else {
+                        None
+                    };
+                    if let Some((toe, a)) = on_line {
+                        (cut_run_m, cut_from) = (cut_before.0 + d_s, cut_before.1);
+                        cut_dir = Some(a);
                         weak_run_m = 0.0;
                         weak_from = None;
+                        let id = *next_virtual;
+                        *next_virtual += 1;
+                        (id, toe.xyz)
+                    } else {
+                        // A weak pick counts as the curb only where the ground steps up beside it
+                        // or a virtual profile shows a toe there; otherwise it adds to the
+                        // unconfirmed stretch.
+                        if weak && params.weak_run_max_m > 0.0 {
+                            let near = |t: &ProfileToe| {
+                                (t.xyz[0] - p[0]).hypot(t.xyz[1] - p[1]) <= WEAK_CONFIRM_M
+                            };
+                            let cut_ok = picked.len() + prior_steps >= CUT_MIN_TRACK_STEPS
+                                && params.cut_follow_max_m > 0.0;
+                            let confirmed = side_step(input, grid, n, along)
+                                .is_some_and(|d| d * up >= WEAK_CONFIRM_STEP_M)
+                                || profile_toe(input, grid, c, along, up, 2.0 * l, params)
+                                    .filter(near)
+                                    .is_some()
+                                || (cut_ok
+                                    && cut_toe(input, grid, c, along, up, 2.0 * l, params)
+                                        .filter(near)
+                                        .is_some());
+                            if confirmed {
+                                weak_run_m = 0.0;
+                                weak_from = None;
+                            } else {
+                                weak_run_m += (p[0] - cur[0]).hypot(p[1] - cur[1]);
+                                weak_from.get_or_insert(picked.len());
+                                if weak_run_m > params.weak_run_max_m {
+                                    break;
+                                }
+                            }
+                        } else {
+                            weak_run_m = 0.0;
+                            weak_from = None;
+                        }
+                        (n as u32, p)
                     }
-                    (n as u32, p)
                 }
             }
         };
@@ -549,6 +674,12 @@ fn track_one_way(
         // curb face, and would lift the search position off the ground within a few gap
         // steps.
         let v_new = clamp_climb(v_new);
+        // On a cut's toe the direction is the fitted line's, and so is the last difference
+        // vector's: one toe's scatter across the line does not turn the search.
+        let (v_new, u) = match cut_dir {
+            Some(a) => (with_heading(v_new, a), with_heading(u, a)),
+            None => (v_new, u),
+        };
         if gap == 0 {
             let dturn =
                 (v[0] * v_new[1] - v[1] * v_new[0]).atan2(v[0] * v_new[0] + v[1] * v_new[1]);
@@ -889,6 +1020,36 @@ mod tests {
         let t0 = track_from(&c, &off, 6.5);
         let far0 = t0.xyz.iter().map(|q| q[0]).fold(f64::MIN, f64::max);
         assert!(far0 < 8.5, "without cut following: x = {far0}");
+    }
+
+    #[test]
+    fn the_line_ahead_does_not_follow_the_scatter_of_cut_toes() {
+        // Toes every 0.15 m along y = 0.3·x (driving towards +x), alternately 0.08 m either
+        // side of the line, the last one 0.08 m to its left.
+        let len = 1.0f64.hypot(0.3);
+        let (t, n) = ([1.0 / len, 0.3 / len], [-0.3 / len, 1.0 / len]);
+        let picked: Vec<(u32, [f64; 3])> = (0..20)
+            .map(|k| {
+                let s = 0.15 * k as f64;
+                let off = if k % 2 == 1 { 0.08 } else { -0.08 };
+                (k, [s * t[0] + off * n[0], s * t[1] + off * n[1], 0.0])
+            })
+            .collect();
+        let cur = picked.last().unwrap().1;
+        let (p, a) = line_ahead(&picked, cur, [1.0, 0.0], 0.15).expect("a line");
+        // Near the line (not 0.08 m off it, where the last toe is; the alternation
+        // itself tilts the fit by about 1°), 0.15 m past that toe.
+        let across = p[0] * n[0] + p[1] * n[1];
+        let along = p[0] * t[0] + p[1] * t[1];
+        assert!(across.abs() < 0.03, "{across}");
+        assert!((along - (19.0 * 0.15 + 0.15)).abs() < 0.01, "{along}");
+        assert!((a[0] * t[0] + a[1] * t[1]) > 0.999, "{a:?}");
+        // Oriented along the search direction given, and refused across it.
+        let (_, back) = line_ahead(&picked, cur, [-1.0, 0.0], 0.15).unwrap();
+        assert!(back[0] < 0.0);
+        assert!(line_ahead(&picked, cur, [-0.3, 1.0], 0.15).is_none());
+        // Under 1 m of track gives no line.
+        assert!(line_ahead(&picked[..6], picked[5].1, [1.0, 0.0], 0.15).is_none());
     }
 
     #[test]
