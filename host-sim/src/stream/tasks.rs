@@ -212,12 +212,19 @@ fn ring_times(traj: &Trajectory, times: (f64, f64), reach_m: f64) -> (f64, f64) 
     let route = Route::new(traj);
     let t: Vec<f64> = traj.samples.iter().map(|p| p.t).collect();
     let arc: Vec<f64> = t.iter().map(|&s| route.arc_at(s).unwrap_or(0.0)).collect();
-    let station = |time: f64| {
+    // The stations of the samples at or before and at or after a time (the wider side).
+    let station_before = |time: f64| {
         let i = t.partition_point(|&s| s <= time).saturating_sub(1);
         arc.get(i).copied().unwrap_or(0.0)
     };
+    let station_after = |time: f64| {
+        let i = t
+            .partition_point(|&s| s < time)
+            .min(t.len().saturating_sub(1));
+        arc.get(i).copied().unwrap_or(0.0)
+    };
     let t0 = if times.0.is_finite() {
-        let s = station(times.0) - reach_m;
+        let s = station_before(times.0) - reach_m;
         let i = arc.partition_point(|&a| a <= s);
         t.get(i.saturating_sub(1))
             .copied()
@@ -227,7 +234,7 @@ fn ring_times(traj: &Trajectory, times: (f64, f64), reach_m: f64) -> (f64, f64) 
         times.0
     };
     let t1 = if times.1.is_finite() {
-        let s = station(times.1) + reach_m;
+        let s = station_after(times.1) + reach_m;
         let i = arc.partition_point(|&a| a < s);
         t.get(i).copied().unwrap_or(f64::INFINITY).max(times.1)
     } else {
