@@ -17,6 +17,17 @@ use std::path::{Path, PathBuf};
 /// bytes; the slab is capped whatever the record length).
 const MAX_SLAB_BYTES: u64 = 64 << 20;
 
+/// Slabs a spinning sensor's LAZ file decodes at once. LAZ chunks (50 000 points by
+/// default) are decompressed in parallel on rayon's pool only when one call spans several
+/// of them, so such a file is decoded several slabs ahead and its slabs are taken from the
+/// decoded records (whole slabs: those handed on are the slabs of one-slab decoding).
+/// Spinning sensors' files only: they stream about a million points a second, and their
+/// stage holds far more than these slabs (profilers' files keep one slab in memory).
+const LAZ_AHEAD_SLABS: u64 = 8;
+
+/// Most bytes decoded ahead ([`LAZ_AHEAD_SLABS`] fewer slabs of long records).
+const MAX_AHEAD_BYTES: u64 = 16 << 20;
+
 /// Names of an extra-bytes dimension that holds a spinning sensor's ring (laser number),
 /// matched without regard to case.
 pub const RING_NAMES: [&str; 3] = ["ring", "laser_id", "channel"];
@@ -97,6 +108,12 @@ pub struct LasBatches {
     total: u64,
     done: u64,
     slab: u64,
+    /// Records decoded at once: `slab`, or up to [`LAZ_AHEAD_SLABS`] slabs of a spinning
+    /// sensor's LAZ file.
+    ahead: u64,
+    /// `pd`'s records not yet taken: `[next, filled)`.
+    next: usize,
+    filled: usize,
     scanner: Option<u16>,
     selection: Option<ScannerSelection>,
     channels_seen: [bool; 4],
@@ -143,6 +160,11 @@ impl LasBatches {
         let base_len = record_len.saturating_sub(usize::from(header.point_format().extra_bytes));
         let ring = RingDim::find(&header, base_len)
             .filter(|r| r.at + [0, 1, 1, 2, 2, 4, 4, 8, 8][usize::from(r.data_type)] <= record_len);
+        let ahead = if head.compressed && ring.is_some() {
+            slab * (MAX_AHEAD_BYTES / (slab * record_len.max(1) as u64)).clamp(1, LAZ_AHEAD_SLABS)
+        } else {
+            slab
+        };
         Ok(Self {
             ring,
             path: path.to_path_buf(),
@@ -155,6 +177,9 @@ impl LasBatches {
             extended,
             done: 0,
             slab,
+            ahead,
+            next: 0,
+            filled: 0,
             scanner: opts.scanner,
             selection: match (opts.scanner, extended) {
                 (None, _) => Some(ScannerSelection::All),
@@ -194,29 +219,19 @@ impl LasBatches {
     pub fn read_into(&mut self, out: &mut PointBatch, max: usize) -> Result<u64, LasError> {
         let mut decoded = 0u64;
         while decoded < max as u64 && self.done < self.total {
+            if self.next == self.filled {
+                self.decode_ahead()?;
+            }
             let want = self
                 .slab
                 .min(self.total - self.done)
-                .min(max as u64 - decoded);
-            let n = self
-                .reader
-                .fill_points(want.max(1), &mut self.pd)
-                .map_err(|e| LasError::Las {
-                    path: self.path.clone(),
-                    what: format!("decoding points after point {}: {e}", self.done),
-                })?;
-            if n == 0 {
-                return Err(LasError::Truncated {
-                    path: self.path.clone(),
-                    what: format!(
-                        "the header says {} points but only {} could be decoded",
-                        self.total, self.done
-                    ),
-                });
-            }
-            self.take_slab(out)?;
-            self.done += n;
-            decoded += n;
+                .min(max as u64 - decoded)
+                .min((self.filled - self.next) as u64);
+            let records = self.next..self.next + want as usize;
+            self.take_slab(out, records)?;
+            self.next += want as usize;
+            self.done += want;
+            decoded += want;
         }
         if self.done >= self.total && decoded == 0 {
             self.finish_checks()?;
@@ -224,9 +239,37 @@ impl LasBatches {
         Ok(decoded)
     }
 
-    fn take_slab(&mut self, out: &mut PointBatch) -> Result<(), LasError> {
-        let raw = self.pd.raw_bytes();
+    /// Decodes the next `ahead` records (fewer at the end of the file) into `pd`.
+    fn decode_ahead(&mut self) -> Result<(), LasError> {
+        let want = self.ahead.min(self.total - self.done);
+        let n = self
+            .reader
+            .fill_points(want.max(1), &mut self.pd)
+            .map_err(|e| LasError::Las {
+                path: self.path.clone(),
+                what: format!("decoding points after point {}: {e}", self.done),
+            })?;
+        if n == 0 {
+            return Err(LasError::Truncated {
+                path: self.path.clone(),
+                what: format!(
+                    "the header says {} points but only {} could be decoded",
+                    self.total, self.done
+                ),
+            });
+        }
+        (self.next, self.filled) = (0, n as usize);
+        Ok(())
+    }
+
+    /// Appends the decoded `records` of `pd` to `out`.
+    fn take_slab(
+        &mut self,
+        out: &mut PointBatch,
+        records: std::ops::Range<usize>,
+    ) -> Result<(), LasError> {
         let rl = self.record_len;
+        let raw = &self.pd.raw_bytes()[records.start * rl..records.end * rl];
         // Scanner channel: bits 4–5 of the flags byte at offset 15 (formats 6–10).
         let channel_of = |rec: &[u8]| if self.extended { (rec[15] >> 4) & 3 } else { 0 };
         if self.extended {
@@ -406,7 +449,7 @@ impl LasBatches {
         }
         r.selection = Some(ScannerSelection::All);
         r.scanner = Some(0);
-        r.take_slab(&mut b)?;
+        r.take_slab(&mut b, 0..1)?;
         Ok(b.t.first().copied())
     }
 }

@@ -341,17 +341,7 @@ fn extract_channel(
     }
     drop(campaign);
     let rings = info.ring.is_some();
-    // Curbs within the arcs' reach ahead and behind are seen from the vehicle's stations
-    // that far away: the window holds that much more road.
-    let window = &WindowParams {
-        margin_m: window.margin_m
-            + if rings {
-                f64::from(cfg.rings.max_reach_m)
-            } else {
-                0.0
-            },
-        ..*window
-    };
+    let window = &stage_window(window, cfg, rings);
     let mut sorted: Option<SortedRuns> = None;
     let mut reordered = false;
     let pass = loop {
@@ -415,6 +405,21 @@ fn extract_channel(
     })
 }
 
+/// The section window for a stage's output. Curbs within the arcs' reach ahead and behind
+/// are seen from the vehicle's stations that far away: with `rings` the window holds that
+/// much more road.
+pub(super) fn stage_window(window: &WindowParams, cfg: &Config, rings: bool) -> WindowParams {
+    WindowParams {
+        margin_m: window.margin_m
+            + if rings {
+                f64::from(cfg.rings.max_reach_m)
+            } else {
+                0.0
+            },
+        ..*window
+    }
+}
+
 /// What a core stage counted: its counters, points dropped before / after the trajectory,
 /// points kept, the time span read, the half-arc cut's counters (rings only).
 type StageTotals = (
@@ -426,13 +431,37 @@ type StageTotals = (
 );
 
 /// The core stage: scanlines of a profiler, or rings of a spinning sensor.
-enum Stage<'a> {
+pub(super) enum Stage<'a> {
     Lines(Box<core_stage::CoreStage<'a>>),
     Rings(Box<ring_stage::RingStage<'a>>),
 }
 
-impl Stage<'_> {
-    fn push(
+impl<'a> Stage<'a> {
+    /// The stage for `traj`: rings of a spinning sensor when `rings`, scanlines otherwise.
+    pub(super) fn new(
+        traj: &'a Trajectory,
+        words: &[u32; curbtrace_core::kernel::CONFIG_WORDS],
+        cfg: &Config,
+        rings: bool,
+    ) -> Self {
+        if rings {
+            Stage::Rings(Box::new(ring_stage::RingStage::new(traj, cfg.rings, None)))
+        } else {
+            Stage::Lines(Box::new(core_stage::CoreStage::new(
+                traj, *words, cfg.replay,
+            )))
+        }
+    }
+
+    /// Points kept so far.
+    pub(super) fn points(&self) -> u64 {
+        match self {
+            Stage::Lines(s) => s.points,
+            Stage::Rings(s) => s.points,
+        }
+    }
+
+    pub(super) fn push(
         &mut self,
         b: PointBatch,
     ) -> Result<Option<core_stage::CoreBatch>, core_stage::CoreError> {
@@ -442,7 +471,9 @@ impl Stage<'_> {
         }
     }
 
-    fn finish(&mut self) -> Result<Option<core_stage::CoreBatch>, core_stage::CoreError> {
+    pub(super) fn finish(
+        &mut self,
+    ) -> Result<Option<core_stage::CoreBatch>, core_stage::CoreError> {
         match self {
             Stage::Lines(s) => s.finish(),
             Stage::Rings(s) => s.finish(),
@@ -557,13 +588,7 @@ fn run_pass(
         let core = std::thread::Builder::new()
             .name("ct-core".into())
             .spawn_scoped(s, move || {
-                let mut stage = if rings {
-                    Stage::Rings(Box::new(ring_stage::RingStage::new(traj, cfg.rings, None)))
-                } else {
-                    Stage::Lines(Box::new(core_stage::CoreStage::new(
-                        traj, *words, cfg.replay,
-                    )))
-                };
+                let mut stage = Stage::new(traj, words, cfg, rings);
                 let mut busy = 0.0;
                 for b in rx_b {
                     let b = match b {

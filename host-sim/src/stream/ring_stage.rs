@@ -222,6 +222,12 @@ impl<'a> RingStage<'a> {
         self.sensor
     }
 
+    /// Uses `sensor` rather than the one estimated from the first points (a task that
+    /// starts within the stream takes the stream's).
+    pub fn set_sensor(&mut self, sensor: SensorModel) {
+        self.sensor = Some(sensor);
+    }
+
     /// Takes a batch; returns the core's output for the points of the arcs it completes.
     pub fn push(&mut self, b: PointBatch) -> Result<Option<CoreBatch>, CoreError> {
         let kept = self.intake.admit(&b);

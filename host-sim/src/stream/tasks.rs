@@ -8,11 +8,17 @@
 //! runs the core and the section window exactly as `extract` does, and keeps the pieces of
 //! its own sections unmerged. [`merge`] feeds every section's pieces, in section order,
 //! through the [`Merge`] that `extract` uses, so the edges are those of one `extract` run.
+//!
+//! A spinning sensor's file (one with a ring dimension) runs through the ring stage as in
+//! `extract`: the task reads the arcs' reach more road on either side, its window holds
+//! that much more, and its arcs are cut with the sensor `extract` estimates from the
+//! stream's first points.
 
-use super::core_stage::CoreStage;
 use super::merge::{Merge, Piece};
+use super::ring_stage::RingStage;
 use super::window::{SectionWindow, WindowParams};
 use super::STREAM_BATCH_POINTS;
+use super::{stage_window, Stage};
 use crate::bend::route::Route;
 use crate::bend::BendParams;
 use crate::config::{Config, ConfigError};
@@ -20,6 +26,7 @@ use crate::io::las_in::ReadOptions;
 use crate::io::trajectory::Trajectory;
 use crate::model::EdgeLine;
 use crate::pipeline::{ExtractError, ExtractOptions, Method};
+use crate::rings::SensorModel;
 use crate::source::campaign::Campaign;
 use crate::source::las_batches::LasBatches;
 use crate::source::PointBatch;
@@ -120,17 +127,32 @@ pub fn run(
     let read = ReadOptions {
         scanner: opts.scanner,
     };
-    let files = files_in(inputs, &read, task.times)?;
+    let rings = Campaign::open(inputs, &read)
+        .map_err(ExtractError::Source)?
+        .info()
+        .ring
+        .is_some();
+    let times = if rings {
+        ring_times(traj, task.times, f64::from(cfg.rings.max_reach_m))
+    } else {
+        task.times
+    };
+    let files = files_in(inputs, &read, times)?;
     let first = files.first().cloned().unwrap_or_default();
     let stream_err = |what: String| ExtractError::Stream {
         path: first.clone(),
         what,
     };
+    let mut core = Stage::new(traj, &words, cfg, rings);
+    if let Stage::Rings(stage) = &mut core {
+        if let Some(s) = stream_sensor(inputs, &read, traj, cfg).map_err(stream_err)? {
+            stage.set_sensor(s);
+        }
+    }
     let mut source = Campaign::open(&files, &read).map_err(ExtractError::Source)?;
-    let mut core = CoreStage::new(traj, words, cfg.replay);
-    let mut win =
-        SectionWindow::new(traj, *window, cfg.bend.clone()).keeping(task.sections.clone());
-    let (t0, t1) = task.times;
+    let window = stage_window(window, cfg, rings);
+    let mut win = SectionWindow::new(traj, window, cfg.bend.clone()).keeping(task.sections.clone());
+    let (t0, t1) = times;
     let mut whole = Vec::new();
     loop {
         let b = source
@@ -179,8 +201,71 @@ pub fn run(
     }
     Ok(TaskOutput {
         pieces,
-        points: core.points,
+        points: core.points(),
     })
+}
+
+/// A spinning sensor's task reads `times` widened by the arcs' reach: its sections'
+/// curbs are seen from stations up to `reach_m` before and after them (as
+/// [`stage_window`] widens the window).
+fn ring_times(traj: &Trajectory, times: (f64, f64), reach_m: f64) -> (f64, f64) {
+    let route = Route::new(traj);
+    let t: Vec<f64> = traj.samples.iter().map(|p| p.t).collect();
+    let arc: Vec<f64> = t.iter().map(|&s| route.arc_at(s).unwrap_or(0.0)).collect();
+    // The stations of the samples at or before and at or after a time (the wider side).
+    let station_before = |time: f64| {
+        let i = t.partition_point(|&s| s <= time).saturating_sub(1);
+        arc.get(i).copied().unwrap_or(0.0)
+    };
+    let station_after = |time: f64| {
+        let i = t
+            .partition_point(|&s| s < time)
+            .min(t.len().saturating_sub(1));
+        arc.get(i).copied().unwrap_or(0.0)
+    };
+    let t0 = if times.0.is_finite() {
+        let s = station_before(times.0) - reach_m;
+        let i = arc.partition_point(|&a| a <= s);
+        t.get(i.saturating_sub(1))
+            .copied()
+            .unwrap_or(f64::NEG_INFINITY)
+            .min(times.0)
+    } else {
+        times.0
+    };
+    let t1 = if times.1.is_finite() {
+        let s = station_after(times.1) + reach_m;
+        let i = arc.partition_point(|&a| a < s);
+        t.get(i).copied().unwrap_or(f64::INFINITY).max(times.1)
+    } else {
+        times.1
+    };
+    (t0, t1)
+}
+
+/// The sensor `extract` estimates from the stream's first points (a task starting within
+/// the stream would estimate it from its own, and cut its arcs with other parameters).
+fn stream_sensor(
+    inputs: &[PathBuf],
+    read: &ReadOptions,
+    traj: &Trajectory,
+    cfg: &Config,
+) -> Result<Option<SensorModel>, String> {
+    let mut source = Campaign::open(inputs, read).map_err(|e| e.to_string())?;
+    let mut probe = RingStage::new(traj, cfg.rings, None);
+    while probe.sensor().is_none() {
+        match source.next_batch(STREAM_BATCH_POINTS) {
+            Ok(Some(b)) => {
+                probe.push(b).map_err(|e| e.to_string())?;
+            }
+            Ok(None) => {
+                probe.finish().map_err(|e| e.to_string())?;
+                break;
+            }
+            Err(e) => return Err(e.to_string()),
+        }
+    }
+    Ok(probe.sensor())
 }
 
 /// The campaign's files (in time order) that can hold points of `times`: a file spans from
@@ -234,4 +319,39 @@ pub fn merge(mut sections: Vec<(i64, Vec<Piece>)>, bend: &BendParams) -> Vec<Edg
             .get_or_insert_with(|| Method::Bend.as_str().to_string());
     }
     edges
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// 100 m due north at 10 m/s from t = 0, a sample every second.
+    fn straight() -> Trajectory {
+        let mut csv = String::from("time,x,y,z,roll,pitch,heading\n");
+        for k in 0..=10 {
+            csv.push_str(&format!("{k},0,{},0,0,0,0\n", 10 * k));
+        }
+        Trajectory::parse_csv(Path::new("t.csv"), &csv).expect("trajectory parses")
+    }
+
+    #[test]
+    fn a_ring_task_reads_the_reach_more_on_either_side() {
+        let traj = straight();
+        // 20 m of reach at 10 m/s is 2 s before and after, to the samples outside.
+        assert_eq!(ring_times(&traj, (4.0, 6.0), 20.0), (2.0, 8.0));
+        assert_eq!(ring_times(&traj, (4.5, 6.5), 20.0), (2.0, 9.0));
+        // Open ends stay open; a reach past the route's ends reads from or to its end.
+        assert_eq!(
+            ring_times(&traj, (f64::NEG_INFINITY, 6.0), 20.0),
+            (f64::NEG_INFINITY, 8.0)
+        );
+        assert_eq!(
+            ring_times(&traj, (1.0, f64::INFINITY), 20.0).1,
+            f64::INFINITY
+        );
+        assert_eq!(ring_times(&traj, (1.0, 9.0), 20.0), (0.0, f64::INFINITY));
+        // No reach: the times are the task's.
+        assert_eq!(ring_times(&traj, (4.0, 6.0), 0.0), (4.0, 6.0));
+    }
 }
