@@ -169,17 +169,22 @@ pub fn extract_edges_with_report(
     (lines, report)
 }
 
-/// A road edge has ground on both sides and a step between `min_step_m` and `max_step_m`,
-/// and is no wall joined to a curb: a chain whose measured part steps above `max_step_m`
-/// over `WALL_SHARE_MAX` of its measured length, or that is mostly unmeasured and steps
-/// above `max_step_m` anywhere, is a wall with a little curb (or ground) at its foot.
+/// A road edge has ground on both sides over at least `MEASURED_SHARE_MIN` of its length
+/// and a step between `min_step_m` and `max_step_m`, and is no wall joined to a curb: a
+/// chain whose measured part steps above `max_step_m` over `WALL_SHARE_MAX` of its
+/// measured length is a wall with a little curb (or ground) at its foot.
 fn is_edge_step(c: &Chain, params: &QiuParams) -> bool {
     let in_range = refine::median_step(c)
         .is_some_and(|h| (params.min_step_m..=params.max_step_m).contains(&h));
     let (measured, wall) = refine::measured_and_wall_shares(c, params.max_step_m);
-    let walled = wall > WALL_SHARE_MAX * measured || (measured < 0.5 && wall > 0.0);
-    in_range && !walled
+    let walled = wall > WALL_SHARE_MAX * measured;
+    in_range && measured >= MEASURED_SHARE_MIN && !walled
 }
+
+/// Least share of a road edge's length with ground on both sides (a measured height
+/// step): a line along the border of the returns has it only where stray points happen
+/// to gather, a curb nearly everywhere.
+const MEASURED_SHARE_MIN: f64 = 0.5;
 
 /// Most share of a road edge's measured length whose step may be wall-sized: the corner
 /// of a curb at a building front picks up a few wall-height steps.
@@ -354,6 +359,11 @@ struct HeightGrid<'a> {
 
 const HEIGHT_CELL_M: f64 = 0.5;
 
+/// Either band of a measured height step holds at least 1/this of the other band's
+/// points: both bands are as large and as far from the scanner within 0.75 m, and the
+/// raised side of a curb is seen at least as densely as the road before it.
+const BAND_SHARE_MIN_INV: usize = 4;
+
 impl<'a> HeightGrid<'a> {
     fn new(pts: &'a [[f64; 3]], origin: [f64; 3]) -> Self {
         let mut cells: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
@@ -369,7 +379,11 @@ impl<'a> HeightGrid<'a> {
 
     /// For every vertex: the median z of points `band` metres outward (away from the
     /// trajectory) minus the median z of points as far inward, within half a metre along
-    /// the line. The vertex z becomes the inward (road) median: the toe's height.
+    /// the line. The vertex z becomes the inward (road) median: the toe's height. The step
+    /// is not measured where a band holds fewer than 3 points or fewer than
+    /// 1/[`BAND_SHARE_MIN_INV`] of the other band's: a line along the border of the
+    /// returns (a shadow's edge, the first or last scan lines) has no surface on one side,
+    /// only a few stray points, which would measure a step that is not there.
     fn measure_steps(&self, c: &mut Chain, band: [f64; 2]) {
         let n = c.pts.len();
         for k in 0..n {
@@ -415,7 +429,8 @@ impl<'a> HeightGrid<'a> {
                 inner.sort_unstable_by(f64::total_cmp);
                 let zi = inner[inner.len() / 2];
                 c.pts[k][2] = zi + self.origin[2];
-                if outer.len() >= 3 {
+                let (few, many) = (inner.len().min(outer.len()), inner.len().max(outer.len()));
+                if few >= 3 && few * BAND_SHARE_MIN_INV >= many {
                     outer.sort_unstable_by(f64::total_cmp);
                     c.h[k] = outer[outer.len() / 2] - zi;
                 }
@@ -577,6 +592,52 @@ mod tests {
             .unwrap();
         let again = one.install(|| extract_edges(&input, &params));
         assert_eq!(again, lines);
+    }
+
+    /// The height step of a line with ground on both sides is measured; that of a line
+    /// along the border of the returns (nothing on one side but a few stray points) is
+    /// not.
+    #[test]
+    fn a_step_needs_ground_on_its_raised_side() {
+        let mut pts = Vec::new();
+        for ix in 0..=40 {
+            for iy in -20..=20 {
+                let (x, y) = (ix as f64 * 0.05, iy as f64 * 0.05);
+                if y < 0.0 {
+                    pts.push([x, y, 0.0]);
+                } else if y > 0.0 {
+                    pts.push([x, y, 0.15]);
+                }
+            }
+        }
+        let measure = |pts: &[[f64; 3]]| {
+            let grid = HeightGrid::new(pts, [0.0; 3]);
+            let mut c = Chain {
+                side: Side::Left,
+                pts: vec![[0.5, 0.0, 0.0], [1.5, 0.0, 0.0]],
+                s: vec![0.5, 1.5],
+                h: vec![f64::NAN; 2],
+                across: false,
+            };
+            grid.measure_steps(&mut c, [0.15, 0.6]);
+            c.h
+        };
+        for h in measure(&pts) {
+            assert!((h - 0.15).abs() < 1e-9, "{h}");
+        }
+        // Either side gone but for a few stray points on every metre.
+        for raised_gone in [true, false] {
+            let mut border: Vec<[f64; 3]> = pts
+                .iter()
+                .copied()
+                .filter(|p| (p[1] < 0.0) == raised_gone)
+                .collect();
+            let stray_y = if raised_gone { 0.3 } else { -0.3 };
+            for k in 0..8 {
+                border.push([k as f64 * 0.25, stray_y, 0.03]);
+            }
+            assert!(measure(&border).iter().all(|h| h.is_nan()));
+        }
     }
 
     #[test]
