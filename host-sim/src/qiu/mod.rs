@@ -169,22 +169,23 @@ pub fn extract_edges_with_report(
     (lines, report)
 }
 
-/// A road edge has ground on both sides over at least `MEASURED_SHARE_MIN` of its length
-/// and a step between `min_step_m` and `max_step_m`, and is no wall joined to a curb: a
-/// chain whose measured part steps above `max_step_m` over `WALL_SHARE_MAX` of its
-/// measured length is a wall with a little curb (or ground) at its foot.
+/// A road edge has ground on both sides and a step between `min_step_m` and `max_step_m`,
+/// has ground on its raised side over more than `1 − NO_GROUND_SHARE_MAX` of its length,
+/// and is no wall joined to a curb: a chain whose measured part steps above `max_step_m`
+/// over `WALL_SHARE_MAX` of its measured length, or that is mostly unmeasured and steps
+/// above `max_step_m` anywhere, is a wall with a little curb (or ground) at its foot.
 fn is_edge_step(c: &Chain, params: &QiuParams) -> bool {
     let in_range = refine::median_step(c)
         .is_some_and(|h| (params.min_step_m..=params.max_step_m).contains(&h));
     let (measured, wall) = refine::measured_and_wall_shares(c, params.max_step_m);
-    let walled = wall > WALL_SHARE_MAX * measured;
-    in_range && measured >= MEASURED_SHARE_MIN && !walled
+    let walled = wall > WALL_SHARE_MAX * measured || (measured < 0.5 && wall > 0.0);
+    in_range && !walled && refine::no_ground_share(c) < NO_GROUND_SHARE_MAX
 }
 
-/// Least share of a road edge's length with ground on both sides (a measured height
-/// step): a line along the border of the returns has it only where stray points happen
-/// to gather, a curb nearly everywhere.
-const MEASURED_SHARE_MIN: f64 = 0.5;
+/// Share of a line's length with no ground on its raised side (see
+/// [`HeightGrid::measure_steps`]) from which it is no road edge: the border of the returns
+/// (a shadow's edge, the first or last scan lines) has none along nearly all of it.
+const NO_GROUND_SHARE_MAX: f64 = 0.5;
 
 /// Most share of a road edge's measured length whose step may be wall-sized: the corner
 /// of a curb at a building front picks up a few wall-height steps.
@@ -379,11 +380,15 @@ impl<'a> HeightGrid<'a> {
 
     /// For every vertex: the median z of points `band` metres outward (away from the
     /// trajectory) minus the median z of points as far inward, within half a metre along
-    /// the line. The vertex z becomes the inward (road) median: the toe's height. The step
-    /// is not measured where a band holds fewer than 3 points or fewer than
-    /// 1/[`BAND_SHARE_MIN_INV`] of the other band's: a line along the border of the
-    /// returns (a shadow's edge, the first or last scan lines) has no surface on one side,
-    /// only a few stray points, which would measure a step that is not there.
+    /// the line. The vertex z becomes the inward (road) median: the toe's height. A band
+    /// holds ground when it has 3 points or more and at least 1/[`BAND_SHARE_MIN_INV`] of
+    /// the other band's. Where the inward band has points and the outward band no ground,
+    /// the step is [`refine::NO_GROUND`]: a line along the border of the returns (a
+    /// shadow's edge, the first or last scan lines) has only a few stray points beyond it,
+    /// which would measure a step that is not there. (A sparse inward band is measured: the
+    /// road beside a near curb lies partly in the vehicle's shadow.) A line across the
+    /// trajectory, whose road side is not known, needs ground in both bands, and has no
+    /// ground where only one band has it.
     fn measure_steps(&self, c: &mut Chain, band: [f64; 2]) {
         let n = c.pts.len();
         for k in 0..n {
@@ -425,15 +430,24 @@ impl<'a> HeightGrid<'a> {
                     }
                 }
             }
+            let ground = |a: usize, b: usize| a >= 3 && a * BAND_SHARE_MIN_INV >= b;
+            let (inner_ground, outer_ground) = (
+                ground(inner.len(), outer.len()),
+                ground(outer.len(), inner.len()),
+            );
             if inner.len() >= 3 {
                 inner.sort_unstable_by(f64::total_cmp);
                 let zi = inner[inner.len() / 2];
                 c.pts[k][2] = zi + self.origin[2];
-                let (few, many) = (inner.len().min(outer.len()), inner.len().max(outer.len()));
-                if few >= 3 && few * BAND_SHARE_MIN_INV >= many {
+                if outer_ground && (inner_ground || !c.across) {
                     outer.sort_unstable_by(f64::total_cmp);
                     c.h[k] = outer[outer.len() / 2] - zi;
                 }
+            }
+            if (!c.across && inner.len() >= 3 && !outer_ground)
+                || (c.across && inner_ground != outer_ground)
+            {
+                c.h[k] = refine::NO_GROUND;
             }
         }
     }
@@ -594,9 +608,10 @@ mod tests {
         assert_eq!(again, lines);
     }
 
-    /// The height step of a line with ground on both sides is measured; that of a line
-    /// along the border of the returns (nothing on one side but a few stray points) is
-    /// not.
+    /// The height step of a line with ground on both sides is measured; a line along the
+    /// border of the returns (nothing on its raised side but a few stray points) has no
+    /// ground there. A sparse road side is measured along the trajectory (the vehicle's
+    /// shadow beside a near curb), not across it, where either side may be the road.
     #[test]
     fn a_step_needs_ground_on_its_raised_side() {
         let mut pts = Vec::new();
@@ -610,33 +625,42 @@ mod tests {
                 }
             }
         }
-        let measure = |pts: &[[f64; 3]]| {
+        let measure = |pts: &[[f64; 3]], across: bool| {
             let grid = HeightGrid::new(pts, [0.0; 3]);
             let mut c = Chain {
                 side: Side::Left,
                 pts: vec![[0.5, 0.0, 0.0], [1.5, 0.0, 0.0]],
                 s: vec![0.5, 1.5],
                 h: vec![f64::NAN; 2],
-                across: false,
+                across,
             };
             grid.measure_steps(&mut c, [0.15, 0.6]);
             c.h
         };
-        for h in measure(&pts) {
-            assert!((h - 0.15).abs() < 1e-9, "{h}");
+        for across in [false, true] {
+            for h in measure(&pts, across) {
+                assert!((h - 0.15).abs() < 1e-9, "{h}");
+            }
         }
-        // Either side gone but for a few stray points on every metre.
-        for raised_gone in [true, false] {
-            let mut border: Vec<[f64; 3]> = pts
+        // One side gone but for a few stray points 30 mm up on every metre.
+        let sparse = |raised_gone: bool| {
+            let mut v: Vec<[f64; 3]> = pts
                 .iter()
                 .copied()
                 .filter(|p| (p[1] < 0.0) == raised_gone)
                 .collect();
             let stray_y = if raised_gone { 0.3 } else { -0.3 };
             for k in 0..8 {
-                border.push([k as f64 * 0.25, stray_y, 0.03]);
+                v.push([k as f64 * 0.25, stray_y, 0.03]);
             }
-            assert!(measure(&border).iter().all(|h| h.is_nan()));
+            v
+        };
+        let no_ground = |h: Vec<f64>| h.iter().all(|&h| h == refine::NO_GROUND);
+        assert!(no_ground(measure(&sparse(true), false)));
+        assert!(no_ground(measure(&sparse(true), true)));
+        assert!(no_ground(measure(&sparse(false), true)));
+        for h in measure(&sparse(false), false) {
+            assert!((h - 0.12).abs() < 1e-9, "{h}");
         }
     }
 

@@ -332,7 +332,8 @@ pub struct Chain {
     pub pts: Vec<[f64; 3]>,
     /// Station of every vertex.
     pub s: Vec<f64>,
-    /// Height step across the line at every vertex, metres (NaN where unknown).
+    /// Height step across the line at every vertex, metres (NaN where unknown,
+    /// [`NO_GROUND`] where its raised side has no ground).
     pub h: Vec<f64>,
     /// The line runs across the trajectory (a side street's curb beyond a corner), not
     /// along it: its vertices are ordered by offset, not by station (see
@@ -965,6 +966,25 @@ pub fn median_step(c: &Chain) -> Option<f64> {
         }
     }
     hw.last().map(|q| q.0)
+}
+
+/// The height step of a vertex with no ground on its raised side (see
+/// `HeightGrid::measure_steps` in the module root): not a measured step.
+pub const NO_GROUND: f64 = f64::NEG_INFINITY;
+
+/// The share of a chain's length whose vertices have no ground on their raised side
+/// ([`NO_GROUND`]); 0 for a chain without length.
+pub fn no_ground_share(c: &Chain) -> f64 {
+    let hw = weighted_steps(c);
+    let total: f64 = hw.iter().map(|q| q.1).sum();
+    if total.is_nan() || total <= 0.0 {
+        return 0.0;
+    }
+    hw.iter()
+        .filter(|q| q.0 == NO_GROUND)
+        .map(|q| q.1)
+        .sum::<f64>()
+        / total
 }
 
 /// The shares of a chain's length whose height step is measured and whose measured step
