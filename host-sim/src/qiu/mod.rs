@@ -363,7 +363,7 @@ const HEIGHT_CELL_M: f64 = 0.5;
 /// Either band of a measured height step holds at least 1/this of the other band's
 /// points: both bands are as large and as far from the scanner within 0.75 m, and the
 /// raised side of a curb is seen at least as densely as the road before it.
-const BAND_SHARE_MIN_INV: usize = 4;
+const BAND_SHARE_MIN_INV: usize = 10;
 
 impl<'a> HeightGrid<'a> {
     fn new(pts: &'a [[f64; 3]], origin: [f64; 3]) -> Self {
