@@ -176,8 +176,7 @@ pub fn refine_by_width(pts: &[EdgePoint], params: &QiuParams) -> WidthRefinement
     }
     let ohalf = 0.5 * params.offset_window_m;
     // Points with the same window share its trend line.
-    let mut window_trend: [HashMap<(usize, usize), Option<(f64, f64, f64, f64)>>; 2] =
-        Default::default();
+    let mut window_trend: [HashMap<(usize, usize), Option<TrendLine>>; 2] = Default::default();
     let mut kept = Vec::new();
     for (i, p) in pts.iter().enumerate() {
         if is_matched[i] {
@@ -213,6 +212,10 @@ const TREND_MIN_BASE_M: f64 = 1.0;
 /// change on the random streets is at most 26° to the curb (0.49).
 const TREND_MAX_SLOPE: f64 = 0.5;
 
+/// (first station, second station, offset at the first, offset per metre): see
+/// [`offset_trend`].
+type TrendLine = (f64, f64, f64, f64);
+
 /// The line along which a side's edge is expected, from its matched points (station,
 /// |offset|, sorted by station) within a window: through the median point (median
 /// station, median offset) of the first half of them and that of the second half, as
@@ -225,7 +228,7 @@ const TREND_MAX_SLOPE: f64 = 0.5;
 /// stray pair, as one median does. The slope is held to [`TREND_MAX_SLOPE`]. Over a
 /// base shorter than [`TREND_MIN_BASE_M`], the window's median offset, level; `None` for
 /// an empty window.
-fn offset_trend(window: &[(f64, f64)]) -> Option<(f64, f64, f64, f64)> {
+fn offset_trend(window: &[(f64, f64)]) -> Option<TrendLine> {
     let median_point = |h: &[(f64, f64)]| {
         let mut st: Vec<f64> = h.iter().map(|q| q.0).collect();
         let mut off: Vec<f64> = h.iter().map(|q| q.1).collect();
