@@ -170,6 +170,7 @@ pub fn extract_edges_with_report(
 }
 
 /// A road edge has ground on both sides and a step between `min_step_m` and `max_step_m`,
+/// has ground on its raised side over more than `1 − NO_GROUND_SHARE_MAX` of its length,
 /// and is no wall joined to a curb: a chain whose measured part steps above `max_step_m`
 /// over `WALL_SHARE_MAX` of its measured length, or that is mostly unmeasured and steps
 /// above `max_step_m` anywhere, is a wall with a little curb (or ground) at its foot.
@@ -178,8 +179,13 @@ fn is_edge_step(c: &Chain, params: &QiuParams) -> bool {
         .is_some_and(|h| (params.min_step_m..=params.max_step_m).contains(&h));
     let (measured, wall) = refine::measured_and_wall_shares(c, params.max_step_m);
     let walled = wall > WALL_SHARE_MAX * measured || (measured < 0.5 && wall > 0.0);
-    in_range && !walled
+    in_range && !walled && refine::no_ground_share(c) < NO_GROUND_SHARE_MAX
 }
+
+/// Share of a line's length with no ground on its raised side (see
+/// [`HeightGrid::measure_steps`]) from which it is no road edge: the border of the returns
+/// (a shadow's edge, the first or last scan lines) has none along nearly all of it.
+const NO_GROUND_SHARE_MAX: f64 = 0.5;
 
 /// Most share of a road edge's measured length whose step may be wall-sized: the corner
 /// of a curb at a building front picks up a few wall-height steps.
@@ -354,6 +360,11 @@ struct HeightGrid<'a> {
 
 const HEIGHT_CELL_M: f64 = 0.5;
 
+/// Either band of a measured height step holds at least 1/this of the other band's
+/// points: both bands are as large and as far from the scanner within 0.75 m, and the
+/// raised side of a curb is seen at least as densely as the road before it.
+const BAND_SHARE_MIN_INV: usize = 10;
+
 impl<'a> HeightGrid<'a> {
     fn new(pts: &'a [[f64; 3]], origin: [f64; 3]) -> Self {
         let mut cells: HashMap<(i64, i64), Vec<u32>> = HashMap::new();
@@ -369,7 +380,15 @@ impl<'a> HeightGrid<'a> {
 
     /// For every vertex: the median z of points `band` metres outward (away from the
     /// trajectory) minus the median z of points as far inward, within half a metre along
-    /// the line. The vertex z becomes the inward (road) median: the toe's height.
+    /// the line. The vertex z becomes the inward (road) median: the toe's height. A band
+    /// holds ground when it has 3 points or more and at least 1/[`BAND_SHARE_MIN_INV`] of
+    /// the other band's. Where the inward band has points and the outward band no ground,
+    /// the step is [`refine::NO_GROUND`]: a line along the border of the returns (a
+    /// shadow's edge, the first or last scan lines) has only a few stray points beyond it,
+    /// which would measure a step that is not there. (A sparse inward band is measured: the
+    /// road beside a near curb lies partly in the vehicle's shadow.) A line across the
+    /// trajectory, whose road side is not known, needs ground in both bands, and has no
+    /// ground where only one band has it.
     fn measure_steps(&self, c: &mut Chain, band: [f64; 2]) {
         let n = c.pts.len();
         for k in 0..n {
@@ -411,14 +430,24 @@ impl<'a> HeightGrid<'a> {
                     }
                 }
             }
+            let ground = |a: usize, b: usize| a >= 3 && a * BAND_SHARE_MIN_INV >= b;
+            let (inner_ground, outer_ground) = (
+                ground(inner.len(), outer.len()),
+                ground(outer.len(), inner.len()),
+            );
             if inner.len() >= 3 {
                 inner.sort_unstable_by(f64::total_cmp);
                 let zi = inner[inner.len() / 2];
                 c.pts[k][2] = zi + self.origin[2];
-                if outer.len() >= 3 {
+                if outer_ground && (inner_ground || !c.across) {
                     outer.sort_unstable_by(f64::total_cmp);
                     c.h[k] = outer[outer.len() / 2] - zi;
                 }
+            }
+            if (!c.across && inner.len() >= 3 && !outer_ground)
+                || (c.across && inner_ground != outer_ground)
+            {
+                c.h[k] = refine::NO_GROUND;
             }
         }
     }
@@ -577,6 +606,62 @@ mod tests {
             .unwrap();
         let again = one.install(|| extract_edges(&input, &params));
         assert_eq!(again, lines);
+    }
+
+    /// The height step of a line with ground on both sides is measured; a line along the
+    /// border of the returns (nothing on its raised side but a few stray points) has no
+    /// ground there. A sparse road side is measured along the trajectory (the vehicle's
+    /// shadow beside a near curb), not across it, where either side may be the road.
+    #[test]
+    fn a_step_needs_ground_on_its_raised_side() {
+        let mut pts = Vec::new();
+        for ix in 0..=40 {
+            for iy in -20..=20 {
+                let (x, y) = (ix as f64 * 0.05, iy as f64 * 0.05);
+                if y < 0.0 {
+                    pts.push([x, y, 0.0]);
+                } else if y > 0.0 {
+                    pts.push([x, y, 0.15]);
+                }
+            }
+        }
+        let measure = |pts: &[[f64; 3]], across: bool| {
+            let grid = HeightGrid::new(pts, [0.0; 3]);
+            let mut c = Chain {
+                side: Side::Left,
+                pts: vec![[0.5, 0.0, 0.0], [1.5, 0.0, 0.0]],
+                s: vec![0.5, 1.5],
+                h: vec![f64::NAN; 2],
+                across,
+            };
+            grid.measure_steps(&mut c, [0.15, 0.6]);
+            c.h
+        };
+        for across in [false, true] {
+            for h in measure(&pts, across) {
+                assert!((h - 0.15).abs() < 1e-9, "{h}");
+            }
+        }
+        // One side gone but for a few stray points 30 mm up on every metre.
+        let sparse = |raised_gone: bool| {
+            let mut v: Vec<[f64; 3]> = pts
+                .iter()
+                .copied()
+                .filter(|p| (p[1] < 0.0) == raised_gone)
+                .collect();
+            let stray_y = if raised_gone { 0.3 } else { -0.3 };
+            for k in 0..8 {
+                v.push([k as f64 * 0.25, stray_y, 0.03]);
+            }
+            v
+        };
+        let no_ground = |h: Vec<f64>| h.iter().all(|&h| h == refine::NO_GROUND);
+        assert!(no_ground(measure(&sparse(true), false)));
+        assert!(no_ground(measure(&sparse(true), true)));
+        assert!(no_ground(measure(&sparse(false), true)));
+        for h in measure(&sparse(false), false) {
+            assert!((h - 0.12).abs() < 1e-9, "{h}");
+        }
     }
 
     #[test]

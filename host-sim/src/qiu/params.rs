@@ -149,8 +149,9 @@ pub struct QiuParams {
     /// (e.g. 7.5 m → 11.5 m).
     pub width_window_m: f64,
     /// A point without a matching partner (its partner hidden, e.g. by a parked car) is
-    /// kept when its offset from the trajectory is within `width_tolerance_m` of the median
-    /// offset of the matched points of its side within this along-track window, metres.
+    /// kept when its offset from the trajectory is within `width_tolerance_m` of the local
+    /// trend (the line through the median points of the window's two halves) of the offsets
+    /// of the matched points of its side within this along-track window, metres.
     /// Not in the paper (which loses such points, cf. its Urban 3): 10 m, short enough to
     /// follow the vehicle swerving around a parked car.
     pub offset_window_m: f64,
