@@ -144,6 +144,46 @@ pub fn estimate_sensor(b: &PointBatch, traj: &Trajectory) -> Option<SensorModel>
     })
 }
 
+/// The sensor of a stream whose first kept points are `first`: estimated once they are
+/// [`ESTIMATE_POINTS`] or more, or at the end of the stream (`last`) from those there are;
+/// without enough of them for [`estimate_sensor`], a 10 Hz sensor with the coarsest step of
+/// docs/simulator.md's sensors (0.35°, so d_b errs towards having neighbours).
+fn sensor_when_ready(first: &PointBatch, traj: &Trajectory, last: bool) -> Option<SensorModel> {
+    if first.len() < ESTIMATE_POINTS && !last {
+        return None;
+    }
+    Some(estimate_sensor(first, traj).unwrap_or(SensorModel {
+        name: "spinning lidar",
+        rings: 64,
+        rate_hz: 10.0,
+        azimuth_step_deg: 0.35,
+    }))
+}
+
+/// The sensor [`RingStage`] estimates from the first points of `batches` (the stream's
+/// batches in order), taking them as its intake does but running nothing through the
+/// core; `None` for a stream without points on the trajectory.
+pub fn stream_sensor<E>(
+    traj: &Trajectory,
+    batches: impl IntoIterator<Item = Result<PointBatch, E>>,
+) -> Result<Option<SensorModel>, E> {
+    let mut intake = Intake::new(traj);
+    let mut first = PointBatch::default();
+    for b in batches {
+        let b = b?;
+        let kept = intake.admit(&b);
+        first.extend_from(&b, kept);
+        if let Some(s) = sensor_when_ready(&first, traj, false) {
+            return Ok(Some(s));
+        }
+    }
+    Ok(if first.is_empty() {
+        None
+    } else {
+        sensor_when_ready(&first, traj, true)
+    })
+}
+
 /// A run of one ring in one half, as indices into the carried points.
 struct Run {
     front: bool,
@@ -233,10 +273,12 @@ impl<'a> RingStage<'a> {
         let kept = self.intake.admit(&b);
         self.carry.extend_from(&b, kept);
         if self.sensor.is_none() {
-            if self.carry.len() < ESTIMATE_POINTS {
+            // Nothing is sent on before the sensor is known: the carry starts at the
+            // stream's first point.
+            self.sensor = sensor_when_ready(&self.carry, self.traj, false);
+            if self.sensor.is_none() {
                 return Ok(None);
             }
-            self.sensor = Some(self.estimate());
         }
         self.run(false)
     }
@@ -247,21 +289,9 @@ impl<'a> RingStage<'a> {
             return Ok(None);
         }
         if self.sensor.is_none() {
-            self.sensor = Some(self.estimate());
+            self.sensor = sensor_when_ready(&self.carry, self.traj, true);
         }
         self.run(true)
-    }
-
-    /// The sensor from the carried points; without enough of them, a 10 Hz sensor with
-    /// the coarsest step of docs/simulator.md's sensors (0.35°, so d_b errs towards
-    /// having neighbours).
-    fn estimate(&self) -> SensorModel {
-        estimate_sensor(&self.carry, self.traj).unwrap_or(SensorModel {
-            name: "spinning lidar",
-            rings: 64,
-            rate_hz: 10.0,
-            azimuth_step_deg: 0.35,
-        })
     }
 
     /// Cuts the carried points into runs, runs the closed ones through the core and

@@ -15,7 +15,7 @@
 //! stream's first points.
 
 use super::merge::{Merge, Piece};
-use super::ring_stage::RingStage;
+use super::ring_stage;
 use super::window::{SectionWindow, WindowParams};
 use super::STREAM_BATCH_POINTS;
 use super::{stage_window, Stage};
@@ -145,7 +145,7 @@ pub fn run(
     };
     let mut core = Stage::new(traj, &words, cfg, rings);
     if let Stage::Rings(stage) = &mut core {
-        if let Some(s) = stream_sensor(inputs, &read, traj, cfg).map_err(stream_err)? {
+        if let Some(s) = stream_sensor(inputs, &read, traj).map_err(stream_err)? {
             stage.set_sensor(s);
         }
     }
@@ -245,27 +245,15 @@ fn ring_times(traj: &Trajectory, times: (f64, f64), reach_m: f64) -> (f64, f64) 
 
 /// The sensor `extract` estimates from the stream's first points (a task starting within
 /// the stream would estimate it from its own, and cut its arcs with other parameters).
+/// Only those points are read, and none runs through the core.
 fn stream_sensor(
     inputs: &[PathBuf],
     read: &ReadOptions,
     traj: &Trajectory,
-    cfg: &Config,
 ) -> Result<Option<SensorModel>, String> {
     let mut source = Campaign::open(inputs, read).map_err(|e| e.to_string())?;
-    let mut probe = RingStage::new(traj, cfg.rings, None);
-    while probe.sensor().is_none() {
-        match source.next_batch(STREAM_BATCH_POINTS) {
-            Ok(Some(b)) => {
-                probe.push(b).map_err(|e| e.to_string())?;
-            }
-            Ok(None) => {
-                probe.finish().map_err(|e| e.to_string())?;
-                break;
-            }
-            Err(e) => return Err(e.to_string()),
-        }
-    }
-    Ok(probe.sensor())
+    let batches = std::iter::from_fn(|| source.next_batch(STREAM_BATCH_POINTS).transpose());
+    ring_stage::stream_sensor(traj, batches).map_err(|e| e.to_string())
 }
 
 /// The campaign's files (in time order) that can hold points of `times`: a file spans from
