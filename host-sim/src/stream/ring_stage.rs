@@ -144,6 +144,11 @@ pub fn estimate_sensor(b: &PointBatch, traj: &Trajectory) -> Option<SensorModel>
     })
 }
 
+/// The carried index of a run's last point.
+fn last_index(r: &Run) -> usize {
+    r.points.last().map_or(0, |q| q.i as usize)
+}
+
 /// The sensor of a stream whose first kept points are `first`: estimated once they are
 /// [`ESTIMATE_POINTS`] or more, or at the end of the stream (`last`) from those there are;
 /// without enough of them for [`estimate_sensor`], a 10 Hz sensor with the coarsest step of
@@ -184,11 +189,22 @@ pub fn stream_sensor<E>(
     })
 }
 
-/// A run of one ring in one half, as indices into the carried points.
+/// A run of one ring in one half.
 struct Run {
     front: bool,
-    points: Vec<u32>,
+    points: Vec<RunPoint>,
     last_t: f64,
+}
+
+/// A point of a run: its index in the carried points, with what the half-arc cut and the
+/// core read of it, copied as the point is sorted into its run (the scan is in time order;
+/// a run's points lie one ring's stride apart in the carry, so reading them there again
+/// would miss the cache at every point).
+#[derive(Clone, Copy)]
+struct RunPoint {
+    i: u32,
+    b: Body,
+    intensity: u16,
 }
 
 /// The ring stage's state between batches.
@@ -335,7 +351,11 @@ impl<'a> RingStage<'a> {
             let slot = &mut self.open[usize::from(ring)];
             match slot {
                 Some(r) if r.front == front && c.t[i] - r.last_t <= gap => {
-                    r.points.push(i as u32);
+                    r.points.push(RunPoint {
+                        i: i as u32,
+                        b: p,
+                        intensity: c.intensity[i],
+                    });
                     r.last_t = c.t[i];
                 }
                 _ => {
@@ -344,7 +364,11 @@ impl<'a> RingStage<'a> {
                     }
                     *slot = Some(Run {
                         front,
-                        points: vec![i as u32],
+                        points: vec![RunPoint {
+                            i: i as u32,
+                            b: p,
+                            intensity: c.intensity[i],
+                        }],
                         last_t: c.t[i],
                     });
                 }
@@ -367,15 +391,15 @@ impl<'a> RingStage<'a> {
             .open
             .iter()
             .flatten()
-            .map(|r| r.points[0] as usize)
+            .map(|r| r.points[0].i as usize)
             .min()
             .unwrap_or(n);
         loop {
             let c2 = self
                 .ended
                 .iter()
-                .filter(|r| *r.points.last().unwrap_or(&0) as usize >= cut)
-                .map(|r| r.points[0] as usize)
+                .filter(|r| last_index(r) >= cut)
+                .map(|r| r.points[0].i as usize)
                 .min()
                 .unwrap_or(cut)
                 .min(cut);
@@ -391,26 +415,26 @@ impl<'a> RingStage<'a> {
         // Ended runs before the cut go now; the rest wait, renumbered from the cut.
         let (mut closed, mut wait): (Vec<Run>, Vec<Run>) = std::mem::take(&mut self.ended)
             .into_iter()
-            .partition(|r| (*r.points.last().unwrap_or(&0) as usize) < cut);
+            .partition(|r| last_index(r) < cut);
         let shift = cut as u32;
         for r in wait.iter_mut().chain(self.open.iter_mut().flatten()) {
-            for i in r.points.iter_mut() {
-                *i -= shift;
+            for q in r.points.iter_mut() {
+                q.i -= shift;
             }
         }
         self.ended = std::mem::take(&mut wait);
-        closed.sort_by_key(|r| r.points[0]);
+        closed.sort_by_key(|r| r.points[0].i);
         let left_out = std::mem::take(&mut self.left_out);
         self.arcs.points_near += left_out[..cut].iter().filter(|&&f| f == 1).count() as u64;
         self.arcs.points_lateral += left_out[..cut].iter().filter(|&&f| f == 2).count() as u64;
-        let mut arcs: Vec<Vec<u32>> = Vec::with_capacity(closed.len());
+        let mut arcs: Vec<Vec<RunPoint>> = Vec::with_capacity(closed.len());
         for r in closed {
-            if let Some(a) = self.accept(&body, r) {
+            if let Some(a) = self.accept(r) {
                 arcs.push(a);
             }
         }
         let kernel = self.kernel.unwrap_or_else(|| sensor.kernel_params());
-        let out = self.run_core(&body, &arcs, &sensor, &kernel, cut)?;
+        let out = self.run_core(&arcs, &sensor, &kernel, cut)?;
         body.drain(..cut);
         self.body = body;
         self.left_out = left_out;
@@ -419,8 +443,8 @@ impl<'a> RingStage<'a> {
         Ok(Some(out))
     }
 
-    /// Thinning and the road checks of one run (`rings::arc`'s rule).
-    fn accept(&mut self, body: &[Body], r: Run) -> Option<Vec<u32>> {
+    /// Thinning and the road checks of one run (`rings::arc`'s rule): the arc's points.
+    fn accept(&mut self, r: Run) -> Option<Vec<RunPoint>> {
         let p = &self.arc;
         let c = &mut self.arcs;
         if r.points.len() < p.min_points {
@@ -428,30 +452,26 @@ impl<'a> RingStage<'a> {
             return None;
         }
         let sep2 = p.min_separation_m * p.min_separation_m;
-        let mut pts = Vec::with_capacity(r.points.len());
+        let mut pts = r.points;
         let mut lastp = (f32::INFINITY, f32::INFINITY);
-        for &i in &r.points {
-            let b = body[i as usize];
-            let (xp, zp) = project(b.x, b.y, b.z);
+        pts.retain(|q| {
+            let (xp, zp) = project(q.b.x, q.b.y, q.b.z);
             let (dx, dz) = (xp - lastp.0, zp - lastp.1);
             if dx * dx + dz * dz < sep2 {
                 c.points_piled += 1;
-                continue;
+                return false;
             }
             lastp = (xp, zp);
-            pts.push(i);
-        }
-        let nadir = pts.iter().copied().min_by(|&a, &b| {
-            body[a as usize]
-                .y
-                .abs()
-                .total_cmp(&body[b as usize].y.abs())
-        })?;
+            true
+        });
+        let nadir = pts
+            .iter()
+            .min_by(|a, b| a.b.y.abs().total_cmp(&b.b.y.abs()))?
+            .b;
         let mut centre: Vec<f32> = pts
             .iter()
-            .map(|&i| body[i as usize])
-            .filter(|b| b.y.abs() <= 1.0)
-            .map(|b| b.z)
+            .filter(|q| q.b.y.abs() <= 1.0)
+            .map(|q| q.b.z)
             .collect();
         if centre.is_empty() {
             c.skipped_no_road += 1;
@@ -463,7 +483,7 @@ impl<'a> RingStage<'a> {
             c.skipped_no_road += 1;
             return None;
         }
-        if body[nadir as usize].x.abs() > p.max_reach_m {
+        if nadir.x.abs() > p.max_reach_m {
             c.skipped_far += 1;
             return None;
         }
@@ -476,8 +496,7 @@ impl<'a> RingStage<'a> {
     /// per arc) and returns the first `cut` carried points with the core's output.
     fn run_core(
         &mut self,
-        body: &[Body],
-        arcs: &[Vec<u32>],
+        arcs: &[Vec<RunPoint>],
         sensor: &SensorModel,
         kernel: &KernelParams,
         cut: usize,
@@ -519,16 +538,14 @@ impl<'a> RingStage<'a> {
                 }
             }
         };
-        let intensity = &self.carry.intensity;
         let points = arcs.iter().map(|arc| {
-            arc.iter().map(|&i| {
-                let b = body[i as usize];
-                let (x_m, z_m) = project(b.x, b.y, b.z);
+            arc.iter().map(|q| {
+                let (x_m, z_m) = project(q.b.x, q.b.y, q.b.z);
                 ArcPoint {
                     x_m,
                     z_m,
-                    intensity: intensity[i as usize],
-                    tag: i,
+                    intensity: q.intensity,
+                    tag: q.i,
                 }
             })
         });
