@@ -630,7 +630,16 @@ fn run_pass(
                 Some(stage.totals())
             })
             .expect("the core thread starts");
-        let mut win = window::SectionWindow::new(traj, *window, cfg.bend.clone());
+        // A spinning sensor's window is the arcs' reach wider, so a drive's last sections
+        // (on a short drive, every one) wait for the end of the stream: they are extracted
+        // side by side then, when the reader and the core have nothing left to do.
+        let threads = if rings {
+            std::thread::available_parallelism().map_or(1, |n| n.get())
+        } else {
+            1
+        };
+        let mut win =
+            window::SectionWindow::new(traj, *window, cfg.bend.clone()).finishing_on(threads);
         let mut edges = Vec::new();
         let mut candidates = 0u64;
         let mut err = None;

@@ -150,6 +150,8 @@ pub struct SectionWindow<'a> {
     pub capped_points: u64,
     /// The point grid of the section last run, rebuilt in place for the next.
     grid: PointGrid,
+    /// Threads the sections left at the end of the stream are extracted on.
+    finish_threads: usize,
 }
 
 /// Least progress along the route, metres, for which the time cap closes a section early;
@@ -172,7 +174,16 @@ impl<'a> SectionWindow<'a> {
             peak_points: 0,
             capped_points: 0,
             grid: PointGrid::build(&[], &[], 1.0, |_| false),
+            finish_threads: 1,
         }
+    }
+
+    /// A window that extracts the sections left at the end of the stream (every point
+    /// read: they no longer wait for one another) on up to `threads` threads, each with a
+    /// grid of its own, and merges them in order as one thread would.
+    pub fn finishing_on(mut self, threads: usize) -> Self {
+        self.finish_threads = threads.max(1);
+        self
     }
 
     /// The merge a window with `bend`'s parameters joins its pieces with.
@@ -270,11 +281,73 @@ impl<'a> SectionWindow<'a> {
         let mut out = Vec::new();
         let l = self.section_m();
         let end = self.route.length_m();
+        if self.finish_threads > 1 {
+            out.extend(self.run_sections_at_end(l, end));
+        }
         while self.start <= end && !self.cols.t.is_empty() {
             out.extend(self.run_section(self.start + l));
         }
         if self.keep.is_none() {
             out.extend(self.merge.close_all());
+        }
+        out
+    }
+
+    /// The sections [`finish`](Self::finish) runs one by one, extracted on
+    /// `finish_threads` threads and then cut, merged and evicted in order as
+    /// [`run_section`](Self::run_section) does.
+    fn run_sections_at_end(&mut self, l: f64, end: f64) -> Vec<EdgeLine> {
+        let m = self.margin_m();
+        // The sections and their points `lo..hi` in the window as it is now: a section
+        // runs while it starts on the route and its predecessor's eviction (of the points
+        // before its start less the margin) leaves points.
+        let mut sections = Vec::new();
+        let n = self.cols.len();
+        let mut s0 = self.start;
+        let mut from = 0;
+        while s0 <= end && from < n {
+            let s1 = s0 + l;
+            let lo = self.cols.t.partition_point(|&t| self.station(t) < s0 - m);
+            let hi = self.cols.t.partition_point(|&t| self.station(t) < s1 + m);
+            sections.push((s0, s1, lo, hi));
+            from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
+            s0 = s1;
+        }
+        let mut out = Vec::new();
+        for group in sections.chunks(self.finish_threads) {
+            let mut found: Vec<Vec<(EdgeLine, Vec<Option<f64>>)>> = Vec::new();
+            std::thread::scope(|scope| {
+                let (cols, traj, route, bend) = (&self.cols, self.traj, &self.route, &self.bend);
+                let others: Vec<_> = group[1..]
+                    .iter()
+                    .map(|&(_, _, lo, hi)| {
+                        scope.spawn(move || {
+                            if hi <= lo {
+                                return Vec::new();
+                            }
+                            let mut grid = PointGrid::build(&[], &[], 1.0, |_| false);
+                            extract_on(cols, traj, route, bend, &mut grid, lo, hi)
+                        })
+                    })
+                    .collect();
+                let (_, _, lo, hi) = group[0];
+                found.push(if hi > lo {
+                    extract_on(cols, traj, route, bend, &mut self.grid, lo, hi)
+                } else {
+                    Vec::new()
+                });
+                for h in others {
+                    found.push(h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)));
+                }
+            });
+            for (&(s0, s1, _, _), edges) in group.iter().zip(found) {
+                out.extend(self.close_section(edges, s0, s1));
+            }
+        }
+        if let Some(&(_, s1, _, _)) = sections.last() {
+            self.start = s1;
+            let keep_from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
+            self.cols.evict(keep_from);
         }
         out
     }
@@ -291,11 +364,26 @@ impl<'a> SectionWindow<'a> {
         } else {
             Vec::new()
         };
+        let closed = self.close_section(edges, s0, s1);
+        self.start = s1;
+        let keep_from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
+        self.cols.evict(keep_from);
+        closed
+    }
+
+    /// The pieces of the edges `edges` of the section `[s0, s1)`, merged (or kept for a
+    /// merge elsewhere).
+    fn close_section(
+        &mut self,
+        edges: Vec<(EdgeLine, Vec<Option<f64>>)>,
+        s0: f64,
+        s1: f64,
+    ) -> Vec<EdgeLine> {
         let mut pieces = Vec::new();
         for (e, steps) in edges {
             pieces.extend(cut_to_section(&self.route, e, steps, s0, s1));
         }
-        let closed = match &self.keep {
+        match &self.keep {
             None => self.merge.push(pieces, s0, s1),
             Some(keep) => {
                 // A section closed early by the time cap keeps the index of the
@@ -306,44 +394,59 @@ impl<'a> SectionWindow<'a> {
                 }
                 Vec::new()
             }
-        };
-        self.start = s1;
-        let keep_from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
-        self.cols.evict(keep_from);
-        closed
+        }
     }
 
     /// The bend method on the window's points `lo..hi`.
     fn extract_range(&mut self, lo: usize, hi: usize) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
-        let c = &self.cols;
-        let (glo, ghi) = (c.base + lo as u64, c.base + hi as u64);
-        let cands: Vec<Candidate> = c
-            .candidates
-            .iter()
-            .filter(|(g, _)| (glo..ghi).contains(g))
-            .map(|(g, cand)| Candidate {
-                point: (g - glo) as u32,
-                ..*cand
-            })
-            .collect();
-        let input = BendInput {
-            x: &c.x[lo..hi],
-            y: &c.y[lo..hi],
-            z: &c.z[lo..hi],
-            t: &c.t[lo..hi],
-            rho_deg: &c.rho[lo..hi],
-            status: &c.status[lo..hi],
-            scanline: &c.scanline[lo..hi],
-            candidates: &cands,
-            trajectory: self.traj,
-        };
-        // One index for the tracker and the curb annotation.
-        bend::point_grid_into(&mut self.grid, &input, &self.bend);
-        let grid = &self.grid;
-        let mut edges = bend::extract_edges_on_grid(&input, grid, &self.route, &self.bend);
-        curb::annotate(&input, grid, &self.route, edges.iter_mut().map(|(e, _)| e));
-        edges
+        extract_on(
+            &self.cols,
+            self.traj,
+            &self.route,
+            &self.bend,
+            &mut self.grid,
+            lo,
+            hi,
+        )
     }
+}
+
+/// The bend method on the points `lo..hi` of `c`, indexed by `grid` (rebuilt in place).
+fn extract_on(
+    c: &Columns,
+    traj: &Trajectory,
+    route: &Route,
+    bend: &BendParams,
+    grid: &mut PointGrid,
+    lo: usize,
+    hi: usize,
+) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
+    let (glo, ghi) = (c.base + lo as u64, c.base + hi as u64);
+    let cands: Vec<Candidate> = c
+        .candidates
+        .iter()
+        .filter(|(g, _)| (glo..ghi).contains(g))
+        .map(|(g, cand)| Candidate {
+            point: (g - glo) as u32,
+            ..*cand
+        })
+        .collect();
+    let input = BendInput {
+        x: &c.x[lo..hi],
+        y: &c.y[lo..hi],
+        z: &c.z[lo..hi],
+        t: &c.t[lo..hi],
+        rho_deg: &c.rho[lo..hi],
+        status: &c.status[lo..hi],
+        scanline: &c.scanline[lo..hi],
+        candidates: &cands,
+        trajectory: traj,
+    };
+    // One index for the tracker and the curb annotation.
+    bend::point_grid_into(grid, &input, bend);
+    let mut edges = bend::extract_edges_on_grid(&input, grid, route, bend);
+    curb::annotate(&input, grid, route, edges.iter_mut().map(|(e, _)| e));
+    edges
 }
 
 /// The runs of an edge's vertices whose station lies in `[s0, s1)`, each as a piece.
