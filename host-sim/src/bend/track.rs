@@ -355,6 +355,64 @@ fn cut_on_line(
     (ahead > 0.25 * d_s).then_some((toe, a))
 }
 
+/// Largest angle between a track's search direction and the driving direction, degrees,
+/// for the track to take a wide profile's toe ([`wide_toe`]): a curb along the road turns
+/// from the driving direction by the road's curvature over the scanner's look-ahead (under
+/// 25° at a 30 m radius), a corner's and a side street's curb by up to 60–120°.
+const ALONG_ROAD_MAX_DEG: f64 = 40.0;
+
+/// Whether the horizontal unit direction `a` runs along the road, either way: within
+/// [`ALONG_ROAD_MAX_DEG`] of the driving direction when the track's newest measured vertex
+/// (or `start`) was scanned. True where the trajectory does not say.
+///
+/// Corners and side streets keep the profiles of the default width: a wider one there
+/// reaches across the mouth's fillet to other steps.
+fn along_the_road(input: &BendInput, picked: &[(u32, [f64; 3])], start: u32, a: [f64; 2]) -> bool {
+    let n = input.x.len();
+    let i = picked
+        .iter()
+        .rev()
+        .map(|v| v.0 as usize)
+        .find(|&i| i < n)
+        .unwrap_or(start as usize);
+    let Some(pose) = input.t.get(i).and_then(|&t| input.trajectory.pose_at(t)) else {
+        return true;
+    };
+    let f = pose.forward();
+    (a[0] * f[0] + a[1] * f[1]).abs() >= ALONG_ROAD_MAX_DEG.to_radians().cos()
+}
+
+/// How much wider than `profile_half_width_m` the profile of [`wide_toe`] is, metres.
+const WIDE_PROFILE_EXTRA_M: f64 = 0.15;
+
+/// The toe on a profile [`WIDE_PROFILE_EXTRA_M`] wider and `half_l` long, for a track
+/// along the road where the profiles of the default width show none.
+///
+/// Far from the scanner, on a curb its scanlines cross at a grazing angle, few points lie
+/// within the default width of the toe on the curb's side, and the ones there are the
+/// face's: the step fit has too little ground to go by, and the track ends in gaps on a
+/// curb in plain view. A wider profile holds the ground behind the face.
+#[allow(clippy::too_many_arguments)]
+fn wide_toe(
+    input: &BendInput,
+    grid: &PointGrid,
+    centre: [f64; 3],
+    along: [f64; 2],
+    up: f64,
+    half_l: f64,
+    params: &BendParams,
+) -> Option<ProfileToe> {
+    profile_toe(input, grid, centre, along, up, half_l, &widened(params))
+}
+
+/// `params` with profiles [`WIDE_PROFILE_EXTRA_M`] wider (see [`wide_toe`]).
+pub(super) fn widened(params: &BendParams) -> BendParams {
+    BendParams {
+        profile_half_width_m: params.profile_half_width_m + WIDE_PROFILE_EXTRA_M,
+        ..params.clone()
+    }
+}
+
 /// `v` (a unit vector) turned to the horizontal heading `a` (a unit vector), keeping its
 /// vertical component.
 fn with_heading(v: [f64; 3], a: [f64; 2]) -> [f64; 3] {
@@ -480,7 +538,12 @@ fn track_one_way(
                 let c = [pred[0], pred[1], cur[2]];
                 let l = params.profile_half_length_m;
                 let toe = profile_toe(input, grid, c, along, up, l, params)
-                    .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params));
+                    .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params))
+                    .or_else(|| {
+                        along_the_road(input, &picked, start, along)
+                            .then(|| wide_toe(input, grid, c, along, up, 2.0 * l, params))
+                            .flatten()
+                    });
                 // Neither ρ nor a step: a curb cut's toe continues the curb's line as a
                 // break of slope, followed for at most `cut_follow_max_m`, and only by a
                 // track that has followed a curb before it.
