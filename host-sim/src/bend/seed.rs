@@ -109,9 +109,9 @@ const PROFILE_SEED_STEP_M: f64 = 0.5;
 /// such a seed, whose track may lie on something else or end before the interval does.
 ///
 /// Where no profile finds a toe on a side, the search is made again with profiles
-/// [`widened`]: on a far curb that its scanlines cross at a grazing angle, a profile of the
-/// default width holds too little ground beside the toe (see [`super::track`]'s
-/// `wide_toe`), and without a seed the curb is never tracked.
+/// [`widened`]: on a far curb that its scanlines cross at a grazing angle, where the core
+/// has no candidates, the profiles of the default width find no toe in most intervals
+/// (see `track::wide_toe`), and a curb without a seed is never tracked.
 ///
 /// Only the interval range the input's points cover is searched, so a streaming window
 /// seeds its own stretch.

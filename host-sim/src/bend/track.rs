@@ -388,10 +388,10 @@ const WIDE_PROFILE_EXTRA_M: f64 = 0.15;
 /// The toe on a profile [`WIDE_PROFILE_EXTRA_M`] wider and `half_l` long, for a track
 /// along the road where the profiles of the default width show none.
 ///
-/// Far from the scanner, on a curb its scanlines cross at a grazing angle, few points lie
-/// within the default width of the toe on the curb's side, and the ones there are the
-/// face's: the step fit has too little ground to go by, and the track ends in gaps on a
-/// curb in plain view. A wider profile holds the ground behind the face.
+/// Far from the scanner, on a curb its scanlines cross at a grazing angle, the profiles of
+/// the default width find no toe along stretches of a curb in plain view, and the track
+/// ends in gaps there; a wider profile holds more ground on either side of the step and
+/// reaches a toe farther from the search position.
 #[allow(clippy::too_many_arguments)]
 fn wide_toe(
     input: &BendInput,
@@ -1113,6 +1113,48 @@ mod tests {
         assert!(line_ahead(&picked, cur, [-0.3, 1.0], 0.15).is_none());
         // Under 1 m of track gives no line.
         assert!(line_ahead(&picked[..6], picked[5].1, [1.0, 0.0], 0.15).is_none());
+    }
+
+    #[test]
+    fn a_wide_profile_reaches_a_toe_beside_the_default_ones_reach() {
+        // The main curb's toe (y = 5) 0.38 m left of the profile's centre: past the 0.30 m
+        // the default profile accepts, within the wide one's 0.45 m.
+        let c = corner();
+        let inp = input(&c);
+        let grid = PointGrid::build(inp.x, inp.y, 0.1, |_| true);
+        let params = BendParams::default();
+        let centre = [3.0, 5.0 - 0.38, 0.0];
+        assert!(profile_toe(&inp, &grid, centre, [1.0, 0.0], 1.0, 0.3, &params).is_none());
+        let toe = wide_toe(&inp, &grid, centre, [1.0, 0.0], 1.0, 0.3, &params).expect("a toe");
+        assert!((toe.xyz[1] - 5.0).abs() < 0.03, "{toe:?}");
+        assert!((toe.step_m - 0.15).abs() < 0.01, "{toe:?}");
+    }
+
+    #[test]
+    fn along_the_road_is_within_40_degrees_of_the_driving_direction() {
+        let mut c = corner();
+        let start = 0u32;
+        // No trajectory: nothing to go by, every direction passes.
+        assert!(along_the_road(&input(&c), &[], start, [0.0, 1.0]));
+        // Driving towards +x (heading 90°) while the scanlines are taken.
+        let pose = |t: f64, x: f64| crate::io::trajectory::Pose {
+            t,
+            x,
+            y: 0.0,
+            z: 2.0,
+            roll_deg: 0.0,
+            pitch_deg: 0.0,
+            heading_deg: 90.0,
+        };
+        c.traj.samples = vec![pose(-1.0, -10.0), pose(100.0, 1000.0)];
+        let inp = input(&c);
+        let deg = |d: f64| [d.to_radians().cos(), d.to_radians().sin()];
+        assert!(along_the_road(&inp, &[], start, deg(0.0)));
+        assert!(along_the_road(&inp, &[], start, deg(180.0)));
+        assert!(along_the_road(&inp, &[], start, deg(35.0)));
+        assert!(!along_the_road(&inp, &[], start, deg(45.0)));
+        assert!(!along_the_road(&inp, &[], start, deg(90.0)));
+        assert!(!along_the_road(&inp, &[], start, deg(-60.0)));
     }
 
     #[test]
