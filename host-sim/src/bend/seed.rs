@@ -13,6 +13,7 @@ use super::grid::PointGrid;
 use super::params::BendParams;
 use super::profile::{profile_toe, usable};
 use super::route::Route;
+use super::track::widened;
 use super::BendInput;
 use crate::model::Side;
 
@@ -107,6 +108,11 @@ const PROFILE_SEED_STEP_M: f64 = 0.5;
 /// on curbs no seed of the core's candidates has reached — also in intervals that have
 /// such a seed, whose track may lie on something else or end before the interval does.
 ///
+/// Where no profile finds a toe on a side, the search is made again with profiles
+/// [`widened`]: on a far curb that its scanlines cross at a grazing angle, where the core
+/// has no candidates, the profiles of the default width find no toe in most intervals
+/// (see `track::wide_toe`), and a curb without a seed is never tracked.
+///
 /// Only the interval range the input's points cover is searched, so a streaming window
 /// seeds its own stretch.
 pub fn profile_seeds(
@@ -129,6 +135,7 @@ pub fn profile_seeds(
     };
     let l_s = params.seed_interval_m.max(1e-3);
     let half_l = 2.0 * params.profile_half_length_m;
+    let wide = widened(params);
     for interval in (s0 / l_s).floor() as i64..=(s1 / l_s).floor() as i64 {
         let mid = (interval as f64 + 0.5) * l_s;
         if mid < s0 || mid > s1 {
@@ -139,32 +146,53 @@ pub fn profile_seeds(
         };
         for (side, up) in [(Side::Left, 1.0), (Side::Right, -1.0)] {
             let n = [-fwd[1] * up, fwd[0] * up];
-            let mut c = PROFILE_SEED_NEAR_M;
-            while c <= reach {
-                let centre = [p[0] + c * n[0], p[1] + c * n[1]];
-                c += PROFILE_SEED_STEP_M;
-                let Some(z) = ground_height(input, grid, centre, params.profile_half_width_m)
-                else {
-                    continue;
-                };
-                let at = [centre[0], centre[1], z];
-                let Some(toe) = profile_toe(input, grid, at, fwd, up, half_l, params) else {
-                    continue;
-                };
-                if let Some(point) = nearest_usable(input, grid, toe.xyz, params.search_radius_m) {
-                    out.push(Seed {
-                        point,
-                        side,
-                        dir: fwd,
-                        interval,
-                        inlier_ratio: 0.0,
-                    });
-                }
-                break;
+            let first = |params: &BendParams| {
+                first_toe_outward(input, grid, p, fwd, n, up, half_l, reach, params)
+            };
+            if let Some(point) = first(params).or_else(|| first(&wide)) {
+                out.push(Seed {
+                    point,
+                    side,
+                    dir: fwd,
+                    interval,
+                    inlier_ratio: 0.0,
+                });
             }
         }
     }
     out
+}
+
+/// The seed point of the first toe that profiles across `fwd` find outward along `n` from
+/// `p`, from [`PROFILE_SEED_NEAR_M`] to `reach` every [`PROFILE_SEED_STEP_M`] (see
+/// [`profile_seeds`]): the usable point nearest to it; `None` where the first toe has none
+/// within the search radius, or there is no toe.
+#[allow(clippy::too_many_arguments)]
+fn first_toe_outward(
+    input: &BendInput,
+    grid: &PointGrid,
+    p: [f64; 2],
+    fwd: [f64; 2],
+    n: [f64; 2],
+    up: f64,
+    half_l: f64,
+    reach: f64,
+    params: &BendParams,
+) -> Option<u32> {
+    let mut c = PROFILE_SEED_NEAR_M;
+    while c <= reach {
+        let centre = [p[0] + c * n[0], p[1] + c * n[1]];
+        c += PROFILE_SEED_STEP_M;
+        let Some(z) = ground_height(input, grid, centre, params.profile_half_width_m) else {
+            continue;
+        };
+        let at = [centre[0], centre[1], z];
+        let Some(toe) = profile_toe(input, grid, at, fwd, up, half_l, params) else {
+            continue;
+        };
+        return nearest_usable(input, grid, toe.xyz, params.search_radius_m);
+    }
+    None
 }
 
 /// Median height of the usable points within `r` (horizontal) of `centre`; `None` with

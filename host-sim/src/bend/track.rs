@@ -355,6 +355,64 @@ fn cut_on_line(
     (ahead > 0.25 * d_s).then_some((toe, a))
 }
 
+/// Largest angle between a track's search direction and the driving direction, degrees,
+/// for the track to take a wide profile's toe ([`wide_toe`]): a curb along the road turns
+/// from the driving direction by the road's curvature over the scanner's look-ahead (under
+/// 25° at a 30 m radius), a corner's and a side street's curb by up to 60–120°.
+const ALONG_ROAD_MAX_DEG: f64 = 40.0;
+
+/// Whether the horizontal unit direction `a` runs along the road, either way: within
+/// [`ALONG_ROAD_MAX_DEG`] of the driving direction when the track's newest measured vertex
+/// (or `start`) was scanned. True where the trajectory does not say.
+///
+/// Corners and side streets keep the profiles of the default width: a wider one there
+/// reaches across the mouth's fillet to other steps.
+fn along_the_road(input: &BendInput, picked: &[(u32, [f64; 3])], start: u32, a: [f64; 2]) -> bool {
+    let n = input.x.len();
+    let i = picked
+        .iter()
+        .rev()
+        .map(|v| v.0 as usize)
+        .find(|&i| i < n)
+        .unwrap_or(start as usize);
+    let Some(pose) = input.t.get(i).and_then(|&t| input.trajectory.pose_at(t)) else {
+        return true;
+    };
+    let f = pose.forward();
+    (a[0] * f[0] + a[1] * f[1]).abs() >= ALONG_ROAD_MAX_DEG.to_radians().cos()
+}
+
+/// How much wider than `profile_half_width_m` the profile of [`wide_toe`] is, metres.
+const WIDE_PROFILE_EXTRA_M: f64 = 0.15;
+
+/// The toe on a profile [`WIDE_PROFILE_EXTRA_M`] wider and `half_l` long, for a track
+/// along the road where the profiles of the default width show none.
+///
+/// Far from the scanner, on a curb its scanlines cross at a grazing angle, the profiles of
+/// the default width find no toe along stretches of a curb in plain view, and the track
+/// ends in gaps there; a wider profile holds more ground on either side of the step and
+/// reaches a toe farther from the search position.
+#[allow(clippy::too_many_arguments)]
+fn wide_toe(
+    input: &BendInput,
+    grid: &PointGrid,
+    centre: [f64; 3],
+    along: [f64; 2],
+    up: f64,
+    half_l: f64,
+    params: &BendParams,
+) -> Option<ProfileToe> {
+    profile_toe(input, grid, centre, along, up, half_l, &widened(params))
+}
+
+/// `params` with profiles [`WIDE_PROFILE_EXTRA_M`] wider (see [`wide_toe`]).
+pub(super) fn widened(params: &BendParams) -> BendParams {
+    BendParams {
+        profile_half_width_m: params.profile_half_width_m + WIDE_PROFILE_EXTRA_M,
+        ..params.clone()
+    }
+}
+
 /// `v` (a unit vector) turned to the horizontal heading `a` (a unit vector), keeping its
 /// vertical component.
 fn with_heading(v: [f64; 3], a: [f64; 2]) -> [f64; 3] {
@@ -480,7 +538,12 @@ fn track_one_way(
                 let c = [pred[0], pred[1], cur[2]];
                 let l = params.profile_half_length_m;
                 let toe = profile_toe(input, grid, c, along, up, l, params)
-                    .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params));
+                    .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params))
+                    .or_else(|| {
+                        along_the_road(input, &picked, start, along)
+                            .then(|| wide_toe(input, grid, c, along, up, 2.0 * l, params))
+                            .flatten()
+                    });
                 // Neither ρ nor a step: a curb cut's toe continues the curb's line as a
                 // break of slope, followed for at most `cut_follow_max_m`, and only by a
                 // track that has followed a curb before it.
@@ -1050,6 +1113,48 @@ mod tests {
         assert!(line_ahead(&picked, cur, [-0.3, 1.0], 0.15).is_none());
         // Under 1 m of track gives no line.
         assert!(line_ahead(&picked[..6], picked[5].1, [1.0, 0.0], 0.15).is_none());
+    }
+
+    #[test]
+    fn a_wide_profile_reaches_a_toe_beside_the_default_ones_reach() {
+        // The main curb's toe (y = 5) 0.38 m left of the profile's centre: past the 0.30 m
+        // the default profile accepts, within the wide one's 0.45 m.
+        let c = corner();
+        let inp = input(&c);
+        let grid = PointGrid::build(inp.x, inp.y, 0.1, |_| true);
+        let params = BendParams::default();
+        let centre = [3.0, 5.0 - 0.38, 0.0];
+        assert!(profile_toe(&inp, &grid, centre, [1.0, 0.0], 1.0, 0.3, &params).is_none());
+        let toe = wide_toe(&inp, &grid, centre, [1.0, 0.0], 1.0, 0.3, &params).expect("a toe");
+        assert!((toe.xyz[1] - 5.0).abs() < 0.03, "{toe:?}");
+        assert!((toe.step_m - 0.15).abs() < 0.01, "{toe:?}");
+    }
+
+    #[test]
+    fn along_the_road_is_within_40_degrees_of_the_driving_direction() {
+        let mut c = corner();
+        let start = 0u32;
+        // No trajectory: nothing to go by, every direction passes.
+        assert!(along_the_road(&input(&c), &[], start, [0.0, 1.0]));
+        // Driving towards +x (heading 90°) while the scanlines are taken.
+        let pose = |t: f64, x: f64| crate::io::trajectory::Pose {
+            t,
+            x,
+            y: 0.0,
+            z: 2.0,
+            roll_deg: 0.0,
+            pitch_deg: 0.0,
+            heading_deg: 90.0,
+        };
+        c.traj.samples = vec![pose(-1.0, -10.0), pose(100.0, 1000.0)];
+        let inp = input(&c);
+        let deg = |d: f64| [d.to_radians().cos(), d.to_radians().sin()];
+        assert!(along_the_road(&inp, &[], start, deg(0.0)));
+        assert!(along_the_road(&inp, &[], start, deg(180.0)));
+        assert!(along_the_road(&inp, &[], start, deg(35.0)));
+        assert!(!along_the_road(&inp, &[], start, deg(45.0)));
+        assert!(!along_the_road(&inp, &[], start, deg(90.0)));
+        assert!(!along_the_road(&inp, &[], start, deg(-60.0)));
     }
 
     #[test]
