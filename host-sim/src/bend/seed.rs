@@ -8,6 +8,7 @@
 use rand::Rng;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 
 use super::grid::PointGrid;
 use super::params::BendParams;
@@ -136,30 +137,38 @@ pub fn profile_seeds(
     let l_s = params.seed_interval_m.max(1e-3);
     let half_l = 2.0 * params.profile_half_length_m;
     let wide = widened(params);
-    for interval in (s0 / l_s).floor() as i64..=(s1 / l_s).floor() as i64 {
-        let mid = (interval as f64 + 0.5) * l_s;
-        if mid < s0 || mid > s1 {
-            continue;
-        }
-        let Some((p, fwd)) = route.pose_at_arc(mid) else {
-            continue;
-        };
-        for (side, up) in [(Side::Left, 1.0), (Side::Right, -1.0)] {
-            let n = [-fwd[1] * up, fwd[0] * up];
-            let first = |params: &BendParams| {
-                first_toe_outward(input, grid, p, fwd, n, up, half_l, reach, params)
-            };
-            if let Some(point) = first(params).or_else(|| first(&wide)) {
-                out.push(Seed {
+    // Every interval and side is searched on its own, on rayon's pool; the seeds come
+    // back in interval order, left before right, whatever the threads.
+    let lines: Vec<(i64, [f64; 2], [f64; 2])> = ((s0 / l_s).floor() as i64
+        ..=(s1 / l_s).floor() as i64)
+        .filter_map(|interval| {
+            let mid = (interval as f64 + 0.5) * l_s;
+            if mid < s0 || mid > s1 {
+                return None;
+            }
+            let (p, fwd) = route.pose_at_arc(mid)?;
+            Some((interval, p, fwd))
+        })
+        .collect();
+    let sides = [(Side::Left, 1.0), (Side::Right, -1.0)];
+    out.par_extend(
+        lines
+            .par_iter()
+            .flat_map_iter(|&l| sides.iter().map(move |&s| (l, s)))
+            .filter_map(|((interval, p, fwd), (side, up))| {
+                let n = [-fwd[1] * up, fwd[0] * up];
+                let first = |params: &BendParams| {
+                    first_toe_outward(input, grid, p, fwd, n, up, half_l, reach, params)
+                };
+                first(params).or_else(|| first(&wide)).map(|point| Seed {
                     point,
                     side,
                     dir: fwd,
                     interval,
                     inlier_ratio: 0.0,
-                });
-            }
-        }
-    }
+                })
+            }),
+    );
     out
 }
 

@@ -21,6 +21,7 @@ use crate::bend::route::Route;
 use crate::bend::BendInput;
 use crate::model::{Category, EdgeLine, BRIDGED_MIN_M};
 use crate::replay::PointStatus;
+use rayon::prelude::*;
 
 /// Half length of the strip along the edge whose points form a cross-section, metres: a
 /// few scanlines at mapping speeds.
@@ -55,9 +56,11 @@ pub fn annotate<'e>(
     if edges.is_empty() {
         return;
     }
-    for e in edges.iter_mut() {
-        sections_along(input, grid, route, e);
-    }
+    // Each edge's cross-sections read only the points and the edge itself: the edges run
+    // on rayon's pool, each summed as on one thread.
+    edges
+        .par_iter_mut()
+        .for_each(|e| sections_along(input, grid, route, e));
     class::classify(route, &mut edges);
 }
 

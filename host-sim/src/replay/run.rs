@@ -252,6 +252,25 @@ pub fn encode_stream(
     Ok(())
 }
 
+std::thread_local! {
+    /// The pipeline this thread ran its last chunk through: a stream runs a chunk every
+    /// 2^14 points, and a fresh allocation per chunk has the kernel map and zero its few
+    /// MB again each time.
+    static PIPELINE: std::cell::Cell<Option<Box<HostPipeline>>> =
+        const { std::cell::Cell::new(None) };
+}
+
+/// A pipeline in its starting state: this thread's last one, reset, or a new one.
+fn take_pipeline() -> Box<HostPipeline> {
+    match PIPELINE.take() {
+        Some(mut p) => {
+            *p = HostPipeline::new();
+            p
+        }
+        None => Box::default(),
+    }
+}
+
 /// One chunk's results, before the scanline numbers are made global.
 struct ChunkOut {
     lines: u32,
@@ -276,7 +295,7 @@ fn run_chunk(
 ) -> Result<ChunkOut, ReplayError> {
     let ChunkSlices { rho, status, line } = slices;
     let start = range.start;
-    let mut pipe: Box<HostPipeline> = Box::default();
+    let mut pipe = take_pipeline();
     let mut out = ChunkOut {
         lines: 0,
         candidates: Vec::new(),
@@ -329,6 +348,7 @@ fn run_chunk(
         Ok(())
     })?;
     pipe.finish(|o| collect(o, &mut out));
+    PIPELINE.set(Some(pipe));
     out.counters.packets = packets;
     out.counters.bytes = bytes;
     out.counters.points_sent = range.len() as u64;

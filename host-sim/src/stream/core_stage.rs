@@ -19,6 +19,13 @@ use curbtrace_core::kernel::CONFIG_WORDS;
 /// Most points held for a stream without line starts.
 pub const UNCUT_MAX_POINTS: usize = 20_000_000;
 
+/// Largest chunk of a batch run through one pipeline: a batch of
+/// [`STREAM_BATCH_POINTS`](super::STREAM_BATCH_POINTS) is cut (at line starts) into about
+/// two, so both cores run the core while the tracker waits for points. The cuts depend
+/// only on the points, and a pipeline started at a line start behaves as one that has been
+/// running, so the output does not depend on this size.
+pub const STREAM_CHUNK_POINTS: usize = super::STREAM_BATCH_POINTS / 2;
+
 /// Errors of the core stage.
 #[derive(Debug, thiserror::Error)]
 pub enum CoreError {
@@ -116,7 +123,10 @@ impl<'a> CoreStage<'a> {
         Self {
             traj,
             words,
-            params,
+            params: ReplayParams {
+                chunk_points: params.chunk_points.min(STREAM_CHUNK_POINTS),
+                ..params
+            },
             rule: None,
             carry: PointBatch::default(),
             next_base: 0,

@@ -300,8 +300,9 @@ fn extract_channel(
     progress: &Progress,
     whole: bool,
 ) -> Result<ExtractResult, ExtractError> {
-    // laz-rs decompresses on rayon's global pool, which nothing else in the stream uses:
-    // its threads are named for the reader when the process has not built it yet.
+    // laz-rs decompresses on rayon's global pool, which nothing else in the stream uses
+    // (the window runs on its own pool): its threads are named for the reader when the
+    // process has not built it yet.
     let _ = rayon::ThreadPoolBuilder::new()
         .thread_name(|i| format!("{READ_THREADS}-{i}"))
         .build_global();
@@ -527,11 +528,38 @@ enum PassError {
 /// Name of the reader thread and the prefix of its decoder pool's threads.
 const READ_THREADS: &str = "ct-read";
 
+/// Prefix of the threads of the pool the window's sections run on.
+const EDGES_THREADS: &str = "ct-edges";
+
+/// The pool the window runs its sections on (the profile seeds and the cross-sections
+/// spread over its threads), built once per process, so that its threads' CPU counts as
+/// the edges' and not as the decoder's on rayon's global pool. `None` when no pool could
+/// be built: the window then runs on the calling thread and the global pool.
+fn edges_pool() -> Option<&'static rayon::ThreadPool> {
+    static POOL: std::sync::OnceLock<Option<rayon::ThreadPool>> = std::sync::OnceLock::new();
+    POOL.get_or_init(|| {
+        rayon::ThreadPoolBuilder::new()
+            .thread_name(|i| format!("{EDGES_THREADS}-{i}"))
+            .stack_size(16 << 20)
+            .build()
+            .ok()
+    })
+    .as_ref()
+}
+
+/// `f` on the [`edges_pool`].
+fn on_edges_pool<T: Send>(f: impl FnOnce() -> T + Send) -> T {
+    match edges_pool() {
+        Some(p) => p.install(f),
+        None => f(),
+    }
+}
+
 /// One pass: reader thread → core thread → window on this thread. CPU per stage: the
 /// reader's is its thread's and the decoder's (rayon's global pool, threads named
 /// [`READ_THREADS`] when the stream named them), the
-/// edges' this thread's while it tracks, the core's the rest of the process's during the
-/// pass (the core thread and the pools it starts per batch).
+/// edges' this thread's while it tracks and the [`edges_pool`]'s, the core's the rest of
+/// the process's during the pass (the core thread and its pipeline pool).
 #[allow(clippy::too_many_arguments)]
 fn run_pass(
     spec: SourceSpec,
@@ -645,13 +673,14 @@ fn run_pass(
         let mut err = None;
         let mut edges_s = 0.0;
         let mut edges_cpu = 0.0;
+        let edges_pool_cpu0 = named_threads_cpu_s(EDGES_THREADS);
         for c in rx_c {
             progress.set(bytes_done.load(Ordering::Relaxed));
             match c {
                 Ok(c) => {
                     candidates += c.candidates.len() as u64;
                     let (t0, c0) = (Instant::now(), thread_cpu_s());
-                    edges.extend(win.push(c));
+                    edges.extend(on_edges_pool(|| win.push(c)));
                     edges_s += t0.elapsed().as_secs_f64();
                     edges_cpu += thread_cpu_s() - c0;
                 }
@@ -675,9 +704,9 @@ fn run_pass(
             )));
         };
         let (t0, c0) = (Instant::now(), thread_cpu_s());
-        edges.extend(win.finish());
+        edges.extend(on_edges_pool(|| win.finish()));
         edges_s += t0.elapsed().as_secs_f64();
-        edges_cpu += thread_cpu_s() - c0;
+        edges_cpu += thread_cpu_s() - c0 + named_threads_cpu_s(EDGES_THREADS) - edges_pool_cpu0;
         progress.set(bytes_total);
         let read_cpu = named_threads_cpu_s(READ_THREADS)
             + f64::from_bits(read_thread_cpu.load(Ordering::Relaxed));
