@@ -90,7 +90,7 @@ fn levels(
     for_each_on_profile(input, grid, centre, along, up, half_l, params, |i, c, a| {
         pts.push((input.scanline[i], c, input.z[i], a));
     });
-    pts.sort_by(|p, q| p.0.cmp(&q.0));
+    pts.sort_by_key(|p| p.0);
     let mut out = Vec::new();
     for run in pts.chunk_by(|p, q| p.0 == q.0) {
         if run.len() < MIN_LINE_POINTS {
