@@ -484,7 +484,7 @@ fn track_one_way(
                 // profile, the step between their levels shows the toe.
                 let toe = profile_toe(input, grid, c, along, up, l, params)
                     .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params))
-                    .or_else(|| sparse_toe(input, grid, c, along, up, 2.0 * l, params));
+                    .or_else(|| sparse_toe(input, grid, &picked, c, along, up, 2.0 * l, params));
                 // Neither ρ nor a step: a curb cut's toe continues the curb's line as a
                 // break of slope, followed for at most `cut_follow_max_m`, and only by a
                 // track that has followed a curb before it.
