@@ -549,7 +549,11 @@ mod tests {
         // The scanner on the sidewalk's side of the curb line (x > 0): the curb hid the
         // road before it, a shadow; the toe half-way between the near edges.
         let shadow = toe_seen_from(&l, 0.0, 5.0).expect("a toe across the shadow");
-        assert!((shadow.xyz[0] - -0.125).abs() < 0.01, "toe at {:?}", shadow.xyz);
+        assert!(
+            (shadow.xyz[0] - -0.125).abs() < 0.01,
+            "toe at {:?}",
+            shadow.xyz
+        );
         // The scanner on the road's side: the same returns are a gap, too wide.
         assert!(toe_seen_from(&l, 0.0, -5.0).is_none());
         // Narrow curb scanlines: within reach seen from either side.
