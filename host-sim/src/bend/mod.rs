@@ -19,6 +19,7 @@ pub mod postfilter;
 pub mod profile;
 pub mod route;
 pub mod seed;
+pub mod sparse;
 pub mod track;
 
 pub use params::BendParams;

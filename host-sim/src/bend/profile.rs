@@ -151,9 +151,29 @@ fn gather(
     half_l: f64,
     params: &BendParams,
 ) -> Vec<(f64, f64, f64)> {
+    let mut prof: Vec<(f64, f64, f64)> = Vec::new();
+    for_each_on_profile(input, grid, centre, along, up, half_l, params, |i, c, a| {
+        prof.push((c, input.z[i], a))
+    });
+    sort_across(prof)
+}
+
+/// Calls `f(i, across, along)` for every usable point `i` of a virtual profile (see
+/// [`profile_toe`]): within `profile_half_width_m` across and `half_l` along of `centre`,
+/// and within the search half-height of its height.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn for_each_on_profile(
+    input: &BendInput,
+    grid: &PointGrid,
+    centre: [f64; 3],
+    along: [f64; 2],
+    up: f64,
+    half_l: f64,
+    params: &BendParams,
+    mut f: impl FnMut(usize, f64, f64),
+) {
     let half_w = params.profile_half_width_m;
     let n = [-along[1] * up, along[0] * up];
-    let mut prof: Vec<(f64, f64, f64)> = Vec::new();
     grid.for_each_within(
         input.x,
         input.y,
@@ -168,11 +188,10 @@ fn gather(
             let a = d[0] * along[0] + d[1] * along[1];
             let c = d[0] * n[0] + d[1] * n[1];
             if a.abs() <= half_l && c.abs() <= half_w {
-                prof.push((c, input.z[i], a));
+                f(i, c, a);
             }
         },
     );
-    sort_across(prof)
 }
 
 /// `prof` sorted by `across`, then height, by `total_cmp`, points equal in both kept in

@@ -13,6 +13,7 @@ use super::grid::PointGrid;
 use super::params::BendParams;
 use super::profile::{cut_toe, profile_toe, usable, ProfileToe};
 use super::seed::Seed;
+use super::sparse::sparse_toe;
 use super::BendInput;
 use crate::model::Side;
 use crate::replay::PointStatus;
@@ -537,13 +538,17 @@ fn track_one_way(
                 // profile twice as long is tried where the short one shows no toe.
                 let c = [pred[0], pred[1], cur[2]];
                 let l = params.profile_half_length_m;
+                // A track along the road tries a wider profile next (a far curb crossed at
+                // a grazing angle). Where the scanlines run along the curb, each at one
+                // offset across the profile, the step between their levels shows the toe.
                 let toe = profile_toe(input, grid, c, along, up, l, params)
                     .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params))
                     .or_else(|| {
                         along_the_road(input, &picked, start, along)
                             .then(|| wide_toe(input, grid, c, along, up, 2.0 * l, params))
                             .flatten()
-                    });
+                    })
+                    .or_else(|| sparse_toe(input, grid, &picked, c, along, up, 2.0 * l, params));
                 // Neither ρ nor a step: a curb cut's toe continues the curb's line as a
                 // break of slope, followed for at most `cut_follow_max_m`, and only by a
                 // track that has followed a curb before it.
