@@ -382,13 +382,17 @@ impl<'a> HeightGrid<'a> {
     /// trajectory) minus the median z of points as far inward, within half a metre along
     /// the line. The vertex z becomes the inward (road) median: the toe's height. A band
     /// holds ground when it has 3 points or more and at least 1/[`BAND_SHARE_MIN_INV`] of
-    /// the other band's. Where the inward band has points and the outward band no ground,
-    /// the step is [`refine::NO_GROUND`]: a line along the border of the returns (a
-    /// shadow's edge, the first or last scan lines) has only a few stray points beyond it,
-    /// which would measure a step that is not there. (A sparse inward band is measured: the
-    /// road beside a near curb lies partly in the vehicle's shadow.) A line across the
-    /// trajectory, whose road side is not known, needs ground in both bands, and has no
-    /// ground where only one band has it.
+    /// the other band's; it is bare when it has fewer than 1/[`BAND_SHARE_MIN_INV`] of the
+    /// other band's and that band has 3 or more. Where the outward band is bare, the step
+    /// is [`refine::NO_GROUND`]: a line along the border of the returns (a shadow's edge,
+    /// the first or last scan lines) has only a few stray points beyond it, which would
+    /// measure a step that is not there. (A sparse inward band is measured: the road beside
+    /// a near curb lies partly in the vehicle's shadow.) A band with too few points to
+    /// measure that is not bare leaves the step unknown: where both bands are sparse (a
+    /// side street's curb far from the scanner) one or two points on the raised side are
+    /// as many as the road side's density allows. A line across the trajectory, whose road
+    /// side is not known, is measured where both bands hold ground and has no ground where
+    /// either band is bare.
     fn measure_steps(&self, c: &mut Chain, band: [f64; 2]) {
         let n = c.pts.len();
         for k in 0..n {
@@ -431,6 +435,7 @@ impl<'a> HeightGrid<'a> {
                 }
             }
             let ground = |a: usize, b: usize| a >= 3 && a * BAND_SHARE_MIN_INV >= b;
+            let bare = |a: usize, b: usize| b >= 3 && a * BAND_SHARE_MIN_INV < b;
             let (inner_ground, outer_ground) = (
                 ground(inner.len(), outer.len()),
                 ground(outer.len(), inner.len()),
@@ -444,9 +449,7 @@ impl<'a> HeightGrid<'a> {
                     c.h[k] = outer[outer.len() / 2] - zi;
                 }
             }
-            if (!c.across && inner.len() >= 3 && !outer_ground)
-                || (c.across && inner_ground != outer_ground)
-            {
+            if bare(outer.len(), inner.len()) || (c.across && bare(inner.len(), outer.len())) {
                 c.h[k] = refine::NO_GROUND;
             }
         }
@@ -661,6 +664,39 @@ mod tests {
         assert!(no_ground(measure(&sparse(false), true)));
         for h in measure(&sparse(false), false) {
             assert!((h - 0.12).abs() < 1e-9, "{h}");
+        }
+    }
+
+    /// Where both bands are sparse, one point on the raised side against ten on the road
+    /// side leaves the step unknown (a far curb's sidewalk, not the border of the returns);
+    /// none against ten is the border.
+    #[test]
+    fn a_sparse_raised_side_is_unknown_and_an_empty_one_bare() {
+        let mut pts = Vec::new();
+        for ix in 0..=8 {
+            for y in [-0.5, -0.25] {
+                pts.push([ix as f64 * 0.25, y, 0.0]);
+            }
+        }
+        let measure = |pts: &[[f64; 3]], across: bool| {
+            let grid = HeightGrid::new(pts, [0.0; 3]);
+            let mut c = Chain {
+                side: Side::Left,
+                pts: vec![[0.5, 0.0, 0.0], [1.5, 0.0, 0.0]],
+                s: vec![0.5, 1.5],
+                h: vec![f64::NAN; 2],
+                across,
+            };
+            grid.measure_steps(&mut c, [0.15, 0.6]);
+            c.h
+        };
+        let mut sparse = pts.clone();
+        sparse.push([0.4, 0.3, 0.15]);
+        sparse.push([1.6, 0.3, 0.15]);
+        for across in [false, true] {
+            assert!(measure(&sparse, across).iter().all(|h| h.is_nan()));
+            let bare = measure(&pts, across);
+            assert!(bare.iter().all(|&h| h == refine::NO_GROUND), "{bare:?}");
         }
     }
 
