@@ -725,7 +725,11 @@ mod stage_tests {
         // A profiler's file keeps `[bend]` as it is.
         assert_eq!(stage_bend(&cfg, false), cfg.bend);
         let b = stage_bend(&cfg, true);
-        assert!((b.search_radius_m - 0.06).abs() < 1e-6, "{}", b.search_radius_m);
+        assert!(
+            (b.search_radius_m - 0.06).abs() < 1e-6,
+            "{}",
+            b.search_radius_m
+        );
         assert_eq!(b.stop_rho_deg, 22.5);
         // Nothing else changes.
         let back = crate::bend::BendParams {

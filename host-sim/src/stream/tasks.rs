@@ -151,7 +151,8 @@ pub fn run(
     }
     let mut source = Campaign::open(&files, &read).map_err(ExtractError::Source)?;
     let window = stage_window(window, cfg, rings);
-    let mut win = SectionWindow::new(traj, window, stage_bend(cfg, rings)).keeping(task.sections.clone());
+    let mut win =
+        SectionWindow::new(traj, window, stage_bend(cfg, rings)).keeping(task.sections.clone());
     let (t0, t1) = times;
     let mut whole = Vec::new();
     loop {
