@@ -6,7 +6,7 @@
 //! [kernel]      # the core's parameters, sent to it in the stream's config packet
 //! [replay]      # line starts and parallel chunks
 //! [bend]        # seeding, tracking, post-filters (Honma et al. §2.6–2.7)
-//! [rings]       # the half-arc cut of spinning sensors' files (docs/spec.md §2)
+//! [rings]       # the half-arc cut of spinning sensors' files (docs/spec.md §2), tracking on rings
 //! [scanners.N]  # the mount of scanner N (lever arm, roll/pitch/yaw; docs/frames.md)
 //! ```
 //!
@@ -62,8 +62,8 @@ pub struct Config {
     pub bend: BendParams,
     /// The plane-based method (`[qiu]`).
     pub qiu: crate::qiu::QiuParams,
-    /// The half-arc cut of a spinning sensor's file (`[rings]`; files with a ring
-    /// dimension only).
+    /// The half-arc cut of a spinning sensor's file and the tracker's settings on its rings
+    /// (`[rings]`; files with a ring dimension only).
     pub rings: crate::rings::ArcParams,
     /// Where each scanner sits on the vehicle (`[scanners.N]`, see `mounts`); without a
     /// table a scanner's mount is zero.

@@ -67,7 +67,9 @@ impl Half {
     }
 }
 
-/// Parameters of the cut (`[rings]` in a config file).
+/// Parameters of the cut (`[rings]` in a config file), and the two settings of the bend
+/// tracker that differ on rings (`track_*`; `stream::stage_bend` puts them in place of
+/// `[bend]`'s on a ring file).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ArcParams {
@@ -91,6 +93,22 @@ pub struct ArcParams {
     /// the kernel's neighbour windows (capped at 255 points) and cost it time while adding
     /// no cross-section. 1 cm is a third of an HDL-64E's spacing 10 m out.
     pub min_separation_m: f32,
+    /// The tracker's search radius on rings (`[bend] search_radius_m` on profilers),
+    /// metres. A profiler's search circle spans dozens of scanlines 1 cm apart; on rings it
+    /// meets one or two ring crossings, dense across the curb (points 4–5 cm apart 12–15 m
+    /// out on an HDL-64E or VLP-16), so the profilers' 0.10 m reaches two points past the
+    /// prediction on either side — at a curb cut onto the ramp's top, which bends as
+    /// sharply as the toe. 0.07 m is about the kernel's d_b on these sensors (0.071 m and
+    /// 0.079 m, `SensorModel::kernel_params`): one point past the prediction on either side.
+    pub track_search_radius_m: f32,
+    /// The tracker's stop threshold on rings, degrees (`[bend] stop_rho_deg` on
+    /// profilers): a step whose search circle holds no point with at least this ρ goes to
+    /// the virtual profile (a step or a cut's toe in the cross-section) or counts as a gap,
+    /// instead of taking the best of weak points. A ring crossing puts only a few points in
+    /// the circle, so a weak pick is not outvoted by the crossings before and after it as
+    /// on a profiler's dense scanlines. Measured on the tuning drives (docs/results.md,
+    /// *Spinning lidars*).
+    pub track_stop_rho_deg: f32,
 }
 
 impl Default for ArcParams {
@@ -102,6 +120,8 @@ impl Default for ArcParams {
             min_depth_m: 1.0,
             min_points: 20,
             min_separation_m: 0.01,
+            track_search_radius_m: 0.07,
+            track_stop_rho_deg: 20.0,
         }
     }
 }
@@ -115,6 +135,8 @@ impl ArcParams {
             ("max_reach_m", self.max_reach_m),
             ("min_depth_m", self.min_depth_m),
             ("min_separation_m", self.min_separation_m),
+            ("track_search_radius_m", self.track_search_radius_m),
+            ("track_stop_rho_deg", self.track_stop_rho_deg),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(format!("{name} = {v}: must be a finite distance ≥ 0"));

@@ -421,6 +421,17 @@ pub(super) fn stage_window(window: &WindowParams, cfg: &Config, rings: bool) -> 
     }
 }
 
+/// The bend method's parameters for a stage's output: `[bend]`, with the tracker's search
+/// radius and stop threshold from `[rings]` (`track_*`) when `rings`.
+pub(super) fn stage_bend(cfg: &Config, rings: bool) -> crate::bend::BendParams {
+    let mut bend = cfg.bend.clone();
+    if rings {
+        bend.search_radius_m = f64::from(cfg.rings.track_search_radius_m);
+        bend.stop_rho_deg = f64::from(cfg.rings.track_stop_rho_deg);
+    }
+    bend
+}
+
 /// What a core stage counted: its counters, points dropped before / after the trajectory,
 /// points kept, the time span read, the half-arc cut's counters (rings only).
 type StageTotals = (
@@ -667,7 +678,7 @@ fn run_pass(
             1
         };
         let mut win =
-            window::SectionWindow::new(traj, *window, cfg.bend.clone()).finishing_on(threads);
+            window::SectionWindow::new(traj, *window, stage_bend(cfg, rings)).finishing_on(threads);
         let mut edges = Vec::new();
         let mut candidates = 0u64;
         let mut err = None;
@@ -738,4 +749,32 @@ fn run_pass(
             selection,
         ))
     })
+}
+
+#[cfg(test)]
+mod stage_tests {
+    use super::*;
+
+    #[test]
+    fn rings_take_the_trackers_radius_and_stop_from_the_rings_table() {
+        let mut cfg = Config::default();
+        cfg.rings.track_search_radius_m = 0.06;
+        cfg.rings.track_stop_rho_deg = 22.5;
+        // A profiler's file keeps `[bend]` as it is.
+        assert_eq!(stage_bend(&cfg, false), cfg.bend);
+        let b = stage_bend(&cfg, true);
+        assert!(
+            (b.search_radius_m - 0.06).abs() < 1e-6,
+            "{}",
+            b.search_radius_m
+        );
+        assert_eq!(b.stop_rho_deg, 22.5);
+        // Nothing else changes.
+        let back = crate::bend::BendParams {
+            search_radius_m: cfg.bend.search_radius_m,
+            stop_rho_deg: cfg.bend.stop_rho_deg,
+            ..b
+        };
+        assert_eq!(back, cfg.bend);
+    }
 }

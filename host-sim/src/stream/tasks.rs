@@ -18,7 +18,7 @@ use super::merge::{Merge, Piece};
 use super::ring_stage;
 use super::window::{SectionWindow, WindowParams};
 use super::STREAM_BATCH_POINTS;
-use super::{stage_window, Stage};
+use super::{stage_bend, stage_window, Stage};
 use crate::bend::route::Route;
 use crate::bend::BendParams;
 use crate::config::{Config, ConfigError};
@@ -151,7 +151,8 @@ pub fn run(
     }
     let mut source = Campaign::open(&files, &read).map_err(ExtractError::Source)?;
     let window = stage_window(window, cfg, rings);
-    let mut win = SectionWindow::new(traj, window, cfg.bend.clone()).keeping(task.sections.clone());
+    let mut win =
+        SectionWindow::new(traj, window, stage_bend(cfg, rings)).keeping(task.sections.clone());
     let (t0, t1) = times;
     let mut whole = Vec::new();
     loop {
