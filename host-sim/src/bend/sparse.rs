@@ -317,9 +317,7 @@ pub fn track_curb_height(
     up: f64,
     params: &BendParams,
 ) -> Option<f64> {
-    let Some(&(_, end)) = picked.last() else {
-        return None;
-    };
+    let &(_, end) = picked.last()?;
     let mut steps = Vec::new();
     let mut since = f64::INFINITY;
     let mut prev = end;
