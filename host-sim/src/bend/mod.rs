@@ -164,5 +164,19 @@ pub fn extract_edges_on_grid(
     postfilter::to_edge_lines_with_steps(&input, grid, route, &tracks, params)
 }
 
+/// The median of `v` (reordered in place), `None` when empty.
+pub fn median(v: &mut [f64]) -> Option<f64> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_unstable_by(|a, b| a.total_cmp(b));
+    let m = v.len() / 2;
+    Some(if v.len() % 2 == 1 {
+        v[m]
+    } else {
+        0.5 * (v[m - 1] + v[m])
+    })
+}
+
 #[cfg(test)]
 mod tests;

@@ -249,6 +249,19 @@ impl Default for BendParams {
     }
 }
 
+/// How much wider than `profile_half_width_m` a widened profile is, metres.
+pub const WIDE_PROFILE_EXTRA_M: f64 = 0.15;
+
+/// `params` with profiles [`WIDE_PROFILE_EXTRA_M`] wider: the second try of the profile
+/// seeds and of a track along the road where profiles of the default width show no toe (a
+/// far curb that its scanlines cross at a grazing angle).
+pub fn widened(params: &BendParams) -> BendParams {
+    BendParams {
+        profile_half_width_m: params.profile_half_width_m + WIDE_PROFILE_EXTRA_M,
+        ..params.clone()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

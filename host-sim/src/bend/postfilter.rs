@@ -15,7 +15,7 @@ use super::grid::PointGrid;
 use super::params::BendParams;
 use super::route::Route;
 use super::track::Track;
-use super::BendInput;
+use super::{median, BendInput};
 use crate::model::{Category, CurbDetail, EdgeLine};
 use crate::replay::PointStatus;
 
@@ -214,20 +214,6 @@ pub fn remove_outside_roadway(_input: &BendInput, route: &Route, tracks: Vec<Tra
         .filter(|(_, out)| !out)
         .map(|(t, _)| t)
         .collect()
-}
-
-/// The median of `v` (reordered in place), `None` when empty.
-pub fn median(v: &mut [f64]) -> Option<f64> {
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_unstable_by(|a, b| a.total_cmp(b));
-    let m = v.len() / 2;
-    Some(if v.len() % 2 == 1 {
-        v[m]
-    } else {
-        0.5 * (v[m - 1] + v[m])
-    })
 }
 
 /// Unit tangent of a track at vertex `k`, over the vertices within `half_span_m` of it.
@@ -610,12 +596,5 @@ mod tests {
             ..input
         };
         assert_eq!(refined_pos(&input, 1), [0.02, 0.0, 1.0]);
-    }
-
-    #[test]
-    fn median_of_even_and_odd() {
-        assert_eq!(median(&mut [3.0, 1.0, 2.0]), Some(2.0));
-        assert_eq!(median(&mut [4.0, 1.0, 2.0, 3.0]), Some(2.5));
-        assert_eq!(median(&mut []), None);
     }
 }

@@ -11,10 +11,9 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
 use super::grid::PointGrid;
-use super::params::BendParams;
+use super::params::{widened, BendParams};
 use super::profile::{profile_toe, usable};
 use super::route::Route;
-use super::track::widened;
 use super::BendInput;
 use crate::model::Side;
 

@@ -20,9 +20,8 @@
 
 use super::grid::PointGrid;
 use super::params::BendParams;
-use super::postfilter::median;
 use super::profile::{for_each_on_profile, usable, ProfileToe};
-use super::BendInput;
+use super::{median, BendInput};
 
 /// Fewest points of a scanline on the profile for it to give a level.
 const MIN_LINE_POINTS: usize = 2;

@@ -697,3 +697,10 @@ fn a_curb_cut_with_a_steep_ramp_is_followed() {
         }
     }
 }
+
+#[test]
+fn median_of_even_and_odd() {
+    assert_eq!(super::median(&mut [3.0, 1.0, 2.0]), Some(2.0));
+    assert_eq!(super::median(&mut [4.0, 1.0, 2.0, 3.0]), Some(2.5));
+    assert_eq!(super::median(&mut []), None);
+}

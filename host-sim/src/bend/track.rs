@@ -10,7 +10,7 @@
 
 use super::claims::{Claims, Join};
 use super::grid::PointGrid;
-use super::params::BendParams;
+use super::params::{widened, BendParams};
 use super::profile::{cut_toe, profile_toe, usable, ProfileToe};
 use super::seed::Seed;
 use super::sparse::sparse_toe;
@@ -383,10 +383,7 @@ fn along_the_road(input: &BendInput, picked: &[(u32, [f64; 3])], start: u32, a: 
     (a[0] * f[0] + a[1] * f[1]).abs() >= ALONG_ROAD_MAX_DEG.to_radians().cos()
 }
 
-/// How much wider than `profile_half_width_m` the profile of [`wide_toe`] is, metres.
-const WIDE_PROFILE_EXTRA_M: f64 = 0.15;
-
-/// The toe on a profile [`WIDE_PROFILE_EXTRA_M`] wider and `half_l` long, for a track
+/// The toe on a [`widened`] profile `half_l` long, for a track
 /// along the road where the profiles of the default width show none.
 ///
 /// Far from the scanner, on a curb its scanlines cross at a grazing angle, the profiles of
@@ -404,14 +401,6 @@ fn wide_toe(
     params: &BendParams,
 ) -> Option<ProfileToe> {
     profile_toe(input, grid, centre, along, up, half_l, &widened(params))
-}
-
-/// `params` with profiles [`WIDE_PROFILE_EXTRA_M`] wider (see [`wide_toe`]).
-pub(super) fn widened(params: &BendParams) -> BendParams {
-    BendParams {
-        profile_half_width_m: params.profile_half_width_m + WIDE_PROFILE_EXTRA_M,
-        ..params.clone()
-    }
 }
 
 /// `v` (a unit vector) turned to the horizontal heading `a` (a unit vector), keeping its

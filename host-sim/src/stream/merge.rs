@@ -9,7 +9,7 @@
 //! short-edge filter of §2.7 runs again on joined edges: a stub left at a boundary is as
 //! short as it looks.
 
-use crate::bend::postfilter::median;
+use crate::bend::median;
 use crate::model::EdgeLine;
 
 /// An edge piece from one section.
