@@ -18,7 +18,7 @@ pub mod profile;
 use crate::bend::grid::PointGrid;
 use crate::bend::postfilter::category_runs;
 use crate::bend::route::Route;
-use crate::bend::BendInput;
+use crate::bend::{median, BendInput};
 use crate::model::{Category, EdgeLine, BRIDGED_MIN_M};
 use crate::replay::PointStatus;
 use rayon::prelude::*;
@@ -192,20 +192,6 @@ fn sections_along(input: &BendInput, grid: &PointGrid, route: &Route, e: &mut Ed
     d.measured = measured;
     d.top_measured = top_measured;
     d.class = vec![e.category.unwrap_or(Category::Curb); m];
-}
-
-/// The median of `v` (reordered), `None` when empty.
-pub fn median(v: &mut [f64]) -> Option<f64> {
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_unstable_by(|a, b| a.total_cmp(b));
-    let m = v.len() / 2;
-    Some(if v.len() % 2 == 1 {
-        v[m]
-    } else {
-        0.5 * (v[m - 1] + v[m])
-    })
 }
 
 /// Cuts closed edges into stretches of one class and one kind of support, with their
