@@ -403,22 +403,6 @@ fn wide_toe(
     profile_toe(input, grid, centre, along, up, half_l, &widened(params))
 }
 
-/// The curb cut's toe on a [`widened`] profile `half_l` long, for a track along the road
-/// following a cut where the profile of the default width shows none: on a far cut that
-/// its scanlines cross at a grazing angle, as [`wide_toe`] on the curb before it.
-#[allow(clippy::too_many_arguments)]
-fn wide_cut_toe(
-    input: &BendInput,
-    grid: &PointGrid,
-    centre: [f64; 3],
-    along: [f64; 2],
-    up: f64,
-    half_l: f64,
-    params: &BendParams,
-) -> Option<ProfileToe> {
-    cut_toe(input, grid, centre, along, up, half_l, &widened(params))
-}
-
 /// `v` (a unit vector) turned to the horizontal heading `a` (a unit vector), keeping its
 /// vertical component.
 fn with_heading(v: [f64; 3], a: [f64; 2]) -> [f64; 3] {
@@ -570,11 +554,7 @@ fn track_one_way(
                         // not one step along v: v follows the scatter of the toes before.
                         let line = line_ahead(&picked, cur, along, d_s);
                         let (cc, ca) = line.map_or((c, along), |(p, a)| ([p[0], p[1], cur[2]], a));
-                        let t = cut_toe(input, grid, cc, ca, up, 2.0 * l, params).or_else(|| {
-                            along_the_road(input, &picked, start, ca)
-                                .then(|| wide_cut_toe(input, grid, cc, ca, up, 2.0 * l, params))
-                                .flatten()
-                        });
+                        let t = cut_toe(input, grid, cc, ca, up, 2.0 * l, params);
                         if t.is_some() {
                             cut_run_m += d_s;
                             cut_from.get_or_insert(picked.len());
