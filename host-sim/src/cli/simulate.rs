@@ -46,6 +46,11 @@ pub struct Args {
     /// The second pass's GNSS offset from the first, metres (direction from the seed).
     #[arg(long, default_value_t = 0.10, requires = "passes")]
     pub pass_offset: f64,
+    /// Also writes every toe line, seen or not (the reference without its visibility
+    /// rule), to this GeoJSON file: where extracted length off the reference lies in the
+    /// reference's holes. One profiler and one pass only.
+    #[arg(long, conflicts_with_all = ["sensor", "scanners", "passes"])]
+    pub whole_toes: Option<PathBuf>,
 }
 
 /// Runs `curbtrace simulate`.
@@ -94,6 +99,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (_, n) => anyhow::bail!("--passes {n}: 1 or 2"),
     }
     .with_context(|| format!("simulating scene {}", args.scene))?;
+    if let Some(path) = &args.whole_toes {
+        simulate::write_whole_toes(&spec, args.seed, args.speed, path)
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
     let [curb, cut, inter, bay] = s.reference_m;
     println!(
         "{}{}: {} points, {} lines, {:.1} m driven in {:.1} s, reference {:.1} m (curb {:.1}, curb_cut {:.1}, intersection {:.1}, bus_bay {:.1}); {:.1} s wall ({:.1} s simulating, {:.1} s writing)",

@@ -394,6 +394,24 @@ pub fn run(
     run_with(spec, seed, speed_kmh, None, out_dir, progress)
 }
 
+/// Writes every toe line of the street that `run` would simulate to `path` (GeoJSON, the
+/// reference's format), seen or not: the reference without its visibility rule. Nothing is
+/// scanned. Extracted length that lies off the reference but on these lines lies in the
+/// reference's holes (docs/simulator.md).
+pub fn write_whole_toes(
+    spec: &SceneSpec,
+    seed: u64,
+    speed_kmh: Option<f64>,
+    path: &Path,
+) -> Result<(), SimError> {
+    let world = World::build(spec.clone(), seed);
+    let speed = speed_kmh.unwrap_or(spec.speed_kmh);
+    let drive = drive::plan(&world, speed, seed);
+    let vis = reference::Visibility::everywhere(&world.ground);
+    let lines = reference::reference_lines(&world.ground, &vis, &drive.traj, world.spec.origin);
+    write::write_reference(path, &lines, &write::crs_for(spec.epsg))
+}
+
 /// How a spinning sensor's run is written: the sensor, and the name of the ring's
 /// extra-bytes dimension (`None`: no ring dimension, as some converters write).
 #[derive(Clone, Copy, Debug)]
@@ -489,6 +507,30 @@ mod tests {
         // The scanner origin is 2 m above the road (cross slope ~2 % → roll ~1°).
         let road = world.ground.height(s[0].x, s[0].y).unwrap().0;
         assert!((s[0].z - road - 2.0).abs() < 0.05);
+    }
+
+    #[test]
+    fn whole_toes_hold_the_reference_and_more() {
+        let sim = tiny();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("toes.geojson");
+        write_whole_toes(&scene_by_name("tiny").unwrap(), 7, None, &path).unwrap();
+        let (whole, _) = crate::model::read_geojson(&path).unwrap();
+        let length = |ls: &[EdgeLine]| ls.iter().map(EdgeLine::length_m).sum::<f64>();
+        assert!(length(&whole) > length(&sim.reference) + 1.0);
+        // Every reference vertex is a vertex of a whole toe line (same world, same rule
+        // for side and category, only the visibility differs).
+        for line in &sim.reference {
+            for p in &line.points {
+                let on = whole.iter().any(|w| {
+                    w.side == line.side
+                        && w.points
+                            .iter()
+                            .any(|q| (q[0] - p[0]).hypot(q[1] - p[1]) < 1e-3)
+                });
+                assert!(on, "reference vertex {p:?} is on no whole toe line");
+            }
+        }
     }
 
     #[test]

@@ -59,6 +59,17 @@ impl Visibility {
         }
     }
 
+    /// Evidence on both sides of every bin: every toe vertex is kept. The reference
+    /// without its visibility rule (`simulate --whole-toes`), against which extracted
+    /// length in the reference's holes is measured.
+    pub fn everywhere(ground: &Ground) -> Self {
+        let mut v = Visibility::new(ground);
+        for bins in v.road.iter_mut().chain(v.curb.iter_mut()) {
+            bins.fill(1);
+        }
+        v
+    }
+
     /// Records one ground return at a true position with toe coordinates `tc`.
     pub fn add(&mut self, tc: &ToeCoord) {
         let (ti, v) = (tc.toe as usize, tc.vtx as usize);
