@@ -36,7 +36,9 @@
 //! - points nearer than [`ArcParams::min_range_m`] horizontally (the vehicle itself,
 //!   missed returns reported near the origin);
 //! - points farther than [`ArcParams::max_lateral_m`] to the side (the ends of the far
-//!   rings' arcs, beyond any road edge sought);
+//!   rings' arcs, beyond any road edge sought), and points farther than
+//!   [`ArcParams::max_azimuth_deg`] from straight ahead or behind (where the ring runs
+//!   nearly along the vehicle's axis and crosses a curb at a grazing angle);
 //! - points closer than [`ArcParams::min_separation_m`] in the x′–z′ plane to the previous
 //!   point kept along the arc (piled up by the projection where the ring runs along the
 //!   vehicle's axis);
@@ -79,6 +81,16 @@ pub struct ArcParams {
     pub min_range_m: f32,
     /// Points farther than this to either side are left out, metres.
     pub max_lateral_m: f32,
+    /// Points whose azimuth lies farther than this from straight ahead (front half-arcs)
+    /// or straight behind (rear ones) are left out, degrees; 90 leaves none out. A ring
+    /// crosses a curb at lateral offset d at azimuth φ with sin φ = d / r, and its path
+    /// there runs at 90° − |φ| to the curb: a near ring meets a curb 7.5 m to the side at
+    /// |φ| ≈ 65°, crossing it at 25°, so 0.5 m across the curb are 1.1 m along it. Where
+    /// the curb changes along its length (a curb cut's transition from full to lowered
+    /// height) such a crossing draws a step behind the toe, and the cross-section x′ = y
+    /// reads it as a toe. 60°: crossings at 30° or more to a curb along the path; chosen
+    /// on simulated tuning drives (docs/results.md, *Spinning lidars*).
+    pub max_azimuth_deg: f32,
     /// Half-arcs whose pseudo-nadir lies farther ahead or behind than this are skipped,
     /// metres. 20 m: beyond it an HDL-64E's rings are more than 2 m apart on the road.
     pub max_reach_m: f32,
@@ -116,6 +128,7 @@ impl Default for ArcParams {
         Self {
             min_range_m: 2.5,
             max_lateral_m: 12.0,
+            max_azimuth_deg: 60.0,
             max_reach_m: 20.0,
             min_depth_m: 1.0,
             min_points: 20,
@@ -132,6 +145,7 @@ impl ArcParams {
         for (name, v) in [
             ("min_range_m", self.min_range_m),
             ("max_lateral_m", self.max_lateral_m),
+            ("max_azimuth_deg", self.max_azimuth_deg),
             ("max_reach_m", self.max_reach_m),
             ("min_depth_m", self.min_depth_m),
             ("min_separation_m", self.min_separation_m),
@@ -143,6 +157,25 @@ impl ArcParams {
             }
         }
         Ok(())
+    }
+
+    /// tan of `max_azimuth_deg`, infinite at 90° and above: the argument of
+    /// [`Self::beyond_side`], computed once per batch of points.
+    pub fn max_azimuth_tan(&self) -> f32 {
+        if self.max_azimuth_deg < 90.0 {
+            self.max_azimuth_deg.to_radians().tan()
+        } else {
+            f32::INFINITY
+        }
+    }
+
+    /// Whether a point at (`x`, `y`) in the vehicle frame lies beyond the side: farther
+    /// than `max_lateral_m` to the side, or farther than `max_azimuth_deg` from the
+    /// vehicle's axis (`tan_max` = [`Self::max_azimuth_tan`]; at infinity none is, the
+    /// product with x = 0 being NaN).
+    #[inline]
+    pub fn beyond_side(&self, x: f32, y: f32, tan_max: f32) -> bool {
+        y.abs() > self.max_lateral_m || y.abs() > x.abs() * tan_max
     }
 }
 
@@ -198,7 +231,7 @@ pub fn half_arcs(s: &Sweep, p: &ArcParams) -> (Vec<HalfArc>, ArcCounters) {
     // −1 to 1 over the front half (right to left) and falls from 1 to −1 over the rear one.
     let mut buckets: Vec<Vec<(f32, u32)>> = vec![Vec::new(); 2 * rings];
     let mut c = ArcCounters::default();
-    let (min2, lat) = (p.min_range_m * p.min_range_m, p.max_lateral_m);
+    let (min2, tan_max) = (p.min_range_m * p.min_range_m, p.max_azimuth_tan());
     for i in 0..s.len() {
         let (x, y) = (s.x[i], s.y[i]);
         let r2 = x * x + y * y;
@@ -206,7 +239,7 @@ pub fn half_arcs(s: &Sweep, p: &ArcParams) -> (Vec<HalfArc>, ArcCounters) {
             c.points_near += 1;
             continue;
         }
-        if y.abs() > lat {
+        if p.beyond_side(x, y, tan_max) {
             c.points_lateral += 1;
             continue;
         }
@@ -342,6 +375,7 @@ mod tests {
         let s = circles(3, 0.5);
         let p = ArcParams {
             min_separation_m: 0.0,
+            max_azimuth_deg: 90.0,
             ..ArcParams::default()
         };
         let (arcs, c) = half_arcs(&s, &p);
@@ -374,7 +408,11 @@ mod tests {
     #[test]
     fn points_piled_up_by_the_projection_are_thinned() {
         let s = circles(3, 0.5);
-        let (arcs, c) = half_arcs(&s, &ArcParams::default());
+        let p = ArcParams {
+            max_azimuth_deg: 90.0,
+            ..ArcParams::default()
+        };
+        let (arcs, c) = half_arcs(&s, &p);
         let kept: usize = arcs.iter().map(|a| a.points.len()).sum();
         assert_eq!(kept as u64 + c.points_piled, s.len() as u64);
         // Near ±90° a 4 m ring's points 0.5° apart are under 1 cm apart in y.
@@ -385,6 +423,37 @@ mod tests {
                 assert!((s.y[i] - s.y[j]).hypot(s.z[i] - s.z[j]) >= 0.01);
             }
         }
+    }
+
+    #[test]
+    fn points_far_from_the_axis_are_left_out() {
+        let s = circles(3, 0.5);
+        let p = ArcParams {
+            min_separation_m: 0.0,
+            ..ArcParams::default()
+        };
+        assert_eq!(p.max_azimuth_deg, 60.0);
+        let (arcs, c) = half_arcs(&s, &p);
+        // 0.5° steps: |φ| ≤ 60° ahead and behind keeps 241 + 241 of 720 per ring (the
+        // boundary points themselves within rounding).
+        let kept: usize = arcs.iter().map(|a| a.points.len()).sum();
+        assert_eq!(kept as u64 + c.points_lateral, s.len() as u64);
+        assert!((3 * 478..=3 * 484).contains(&kept), "{kept}");
+        for a in &arcs {
+            for &i in &a.points {
+                let (x, y) = (s.x[i as usize], s.y[i as usize]);
+                assert!(
+                    y.abs() <= x.abs() * 60f32.to_radians().tan() + 1e-4,
+                    "{x} {y}"
+                );
+            }
+        }
+        // 90° leaves none out.
+        let all = ArcParams {
+            max_azimuth_deg: 90.0,
+            ..p
+        };
+        assert_eq!(half_arcs(&s, &all).1.points_lateral, 0);
     }
 
     #[test]

@@ -8,7 +8,7 @@
 //!    x_b < 0); a run ends when the half changes or the ring is silent for a quarter
 //!    revolution. A run is a half-arc ([`crate::rings::arc`]'s rule, cut in time instead
 //!    of per frame): points nearer than `min_range_m`, farther than `max_lateral_m` to the
-//!    side, or piled up closer than `min_separation_m` in x′–z′ are left out, and arcs that
+//!    side or `max_azimuth_deg` from the vehicle's axis, or piled up closer than `min_separation_m` in x′–z′ are left out, and arcs that
 //!    do not see the road at the centre line or reach farther than `max_reach_m` are
 //!    skipped.
 //! 3. The arcs run through the core, one line each, with the sensor's kernel parameters
@@ -331,7 +331,7 @@ impl<'a> RingStage<'a> {
         }
         // Runs carry over between batches: only the points new since the last batch are
         // sorted into them.
-        let (min2, lat) = (self.arc.min_range_m.powi(2), self.arc.max_lateral_m);
+        let (min2, tan_max) = (self.arc.min_range_m.powi(2), self.arc.max_azimuth_tan());
         self.left_out.resize(n, 0);
         for (i, &p) in body.iter().enumerate().skip(self.scanned) {
             if p.x.is_nan() {
@@ -341,7 +341,7 @@ impl<'a> RingStage<'a> {
                 self.left_out[i] = 1;
                 continue;
             }
-            if p.y.abs() > lat {
+            if self.arc.beyond_side(p.x, p.y, tan_max) {
                 self.left_out[i] = 2;
                 continue;
             }
