@@ -192,7 +192,9 @@ const NO_GROUND_SHARE_MAX: f64 = 0.5;
 const WALL_SHARE_MAX: f64 = 0.25;
 
 /// Most distance between the vertices at which a line's height step is measured, metres:
-/// the line fit leaves long straight stretches with a vertex at either end only.
+/// the line fit leaves long straight stretches with a vertex at either end only. Lines
+/// across the trajectory too: a border of the returns across it (behind a side street's
+/// curb) is otherwise measured at its two ends only, where it meets the curb's returns.
 const STEP_SAMPLE_M: f64 = 1.0;
 
 /// Seconds of trajectory added before and after a section for nearest-trajectory-point
@@ -319,9 +321,7 @@ fn process_section(
     let mut chains = refine::refine_by_continuity(&edge_pts, &width.kept, params);
     let grid = HeightGrid::new(&pts, o);
     for c in &mut chains {
-        if !c.across {
-            *c = refine::densify(c, STEP_SAMPLE_M);
-        }
+        *c = refine::densify(c, STEP_SAMPLE_M);
         let unmeasured = c.across.then(|| c.clone());
         grid.measure_steps(c, params.height_band_m);
         if let Some(mut r) = unmeasured {

@@ -992,7 +992,9 @@ pub fn no_ground_share(c: &Chain) -> f64 {
 
 /// The shares of a chain's length whose height step is measured and whose measured step
 /// is above `wall_m` (a wall or a building front, not a curb), each a fraction of the
-/// whole length; `(0, 0)` for a chain without length.
+/// whole length; `(0, 0)` for a chain without length. On a line across the trajectory a
+/// step below −`wall_m` is a wall too: its road side is only the side of the larger
+/// median step, and a wall on the side taken for the road is as much a wall.
 pub fn measured_and_wall_shares(c: &Chain, wall_m: f64) -> (f64, f64) {
     let hw = weighted_steps(c);
     let total: f64 = hw.iter().map(|q| q.1).sum();
@@ -1000,7 +1002,8 @@ pub fn measured_and_wall_shares(c: &Chain, wall_m: f64) -> (f64, f64) {
         return (0.0, 0.0);
     }
     let measured: f64 = hw.iter().filter(|q| q.0.is_finite()).map(|q| q.1).sum();
-    let wall: f64 = hw.iter().filter(|q| q.0 > wall_m).map(|q| q.1).sum();
+    let walled = |h: f64| h > wall_m || (c.across && h.is_finite() && -h > wall_m);
+    let wall: f64 = hw.iter().filter(|q| walled(q.0)).map(|q| q.1).sum();
     (measured / total, wall / total)
 }
 
@@ -1306,6 +1309,17 @@ mod tests {
         let (measured, wall) = measured_and_wall_shares(&unmeasured, 0.2);
         assert!((measured - 7.5 / 21.0).abs() < 1e-9, "{measured}");
         assert!((wall - 3.0 / 21.0).abs() < 1e-9, "{wall}");
+        // A wall on the side taken for the road: a wall across the trajectory only.
+        let mut sunk = unmeasured.clone();
+        for h in &mut sunk.h[14..16] {
+            *h = -0.3;
+        }
+        sunk.h[17] = NO_GROUND;
+        let wall_along = measured_and_wall_shares(&sunk, 0.2).1;
+        sunk.across = true;
+        let wall_across = measured_and_wall_shares(&sunk, 0.2).1;
+        assert!((wall_along - 1.0 / 21.0).abs() < 1e-9, "{wall_along}");
+        assert!((wall_across - 3.0 / 21.0).abs() < 1e-9, "{wall_across}");
     }
 
     /// Two lined-up curbs at y = 5 with a 10 m gap (x 10..20): longer than the joins
