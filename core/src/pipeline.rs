@@ -34,10 +34,13 @@
 //! assert_eq!(p.counters().kernel_points, 50);
 //! ```
 
-use crate::kernel::{Kernel, KernelParams, OutputMode, ParamsError, PointStatus, ScanlineOutput};
-use crate::scanline::{Ingest, IngestCounters, IngestEvent};
+use crate::kernel::{
+    Kernel, KernelParams, OutputMode, ParamsError, PointStatus, ScanlineOutput, CONFIG_WORDS,
+};
+use crate::scanline::{Ingest, IngestCounters, IngestEvent, Line, SplitReason};
 use crate::wire::{
-    CandidatesRepr, EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr, StreamEncoder,
+    CandidatesRepr, EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr, PointRecord,
+    StreamEncoder,
 };
 
 /// Everything the pipeline counted: ingest's counters plus the kernel's, summed over lines,
@@ -137,44 +140,82 @@ impl<const RING: usize, const N: usize> Pipeline<RING, N> {
     /// Processes every complete line in the ring, calling `on_line` with each result; a
     /// config packet reconfigures the kernel (bad ones are counted, the old parameters stay).
     pub fn run(&mut self, mut on_line: impl FnMut(&ScanlineOutput<'_>)) {
+        self.settle_split();
+        loop {
+            let Self {
+                ingest, kernel, c, ..
+            } = self;
+            match ingest.poll() {
+                None => break,
+                Some(IngestEvent::Config(words)) => self.apply_config(&words),
+                Some(IngestEvent::Line(line)) => process_line(kernel, c, line, &mut on_line),
+            }
+        }
+    }
+
+    /// Applies a config packet's parameter words: the kernel and the assembler take them
+    /// (from the next line on); bad ones are counted and the old parameters stay.
+    fn apply_config(&mut self, words: &[u32; CONFIG_WORDS]) {
+        match KernelParams::from_words(words).and_then(|p| self.kernel.set_params(p).map(|()| p)) {
+            Ok(p) => {
+                self.ingest.set_split_params(p.split_params());
+                self.c.configs_applied += 1;
+            }
+            Err(e) => {
+                self.c.configs_rejected += 1;
+                self.c.last_config_error = Some(e);
+            }
+        }
+    }
+
+    /// The assembler takes the kernel's split rules before it sees a point (see
+    /// [`Pipeline::new`]).
+    fn settle_split(&mut self) {
         if self.fresh {
             self.ingest
                 .set_split_params(self.kernel.params().split_params());
             self.fresh = false;
         }
-        while let Some(ev) = self.ingest.poll() {
-            match ev {
-                IngestEvent::Config(words) => {
-                    match KernelParams::from_words(&words)
-                        .and_then(|p| self.kernel.set_params(p).map(|()| p))
-                    {
-                        Ok(p) => {
-                            self.ingest.set_split_params(p.split_params());
-                            self.c.configs_applied += 1;
-                        }
-                        Err(e) => {
-                            self.c.configs_rejected += 1;
-                            self.c.last_config_error = Some(e);
-                        }
-                    }
-                }
-                IngestEvent::Line(line) => {
-                    let out = self.kernel.process(line);
-                    let k = out.counters;
-                    let c = &mut self.c;
-                    c.kernel_lines += 1;
-                    c.kernel_points += u64::from(k.points_in);
-                    c.kept += u64::from(k.kept);
-                    c.irregular += u64::from(k.irregular);
-                    c.no_neighbour += u64::from(k.no_neighbour);
-                    c.non_finite += u64::from(k.non_finite);
-                    c.outside_roi += u64::from(k.outside_roi);
-                    c.peaks += u64::from(k.peaks);
-                    c.left_candidates += u64::from(out.left.is_some());
-                    c.right_candidates += u64::from(out.right.is_some());
-                    on_line(&out);
-                }
-            }
+    }
+
+    /// A config packet's words given directly, without their packet: the line being
+    /// assembled is completed and processed first, then the words apply as
+    /// [`Pipeline::run`] applies a config packet's. With [`Pipeline::push_point`] this is
+    /// the core fed by a caller that holds decoded points (host-sim's replay), skipping
+    /// the bytes, the CRC and the parse; the assembler, the split rules and the kernel are
+    /// the same code, so the lines and their output are too.
+    pub fn push_config(
+        &mut self,
+        words: &[u32; CONFIG_WORDS],
+        mut on_line: impl FnMut(&ScanlineOutput<'_>),
+    ) {
+        self.settle_split();
+        let Self {
+            ingest, kernel, c, ..
+        } = self;
+        if let Some(line) = ingest.close_line(SplitReason::Config) {
+            process_line(kernel, c, line, &mut on_line);
+        }
+        self.apply_config(words);
+    }
+
+    /// One point given directly, at absolute time `t_ns`, as ingest hands a parsed record
+    /// of a points packet to the assembler (a non-finite x′ or z′ is counted and dropped,
+    /// as ingest drops such a record); a line it completes is processed and given to
+    /// `on_line` first. `p.dt_ns` is not read. See [`Pipeline::push_config`].
+    #[inline]
+    pub fn push_point(
+        &mut self,
+        t_ns: u64,
+        p: &PointRecord,
+        mut on_line: impl FnMut(&ScanlineOutput<'_>),
+    ) {
+        self.settle_split();
+        let Self {
+            ingest, kernel, c, ..
+        } = self;
+        while let Some(line) = ingest.offer_point(t_ns, p) {
+            process_line(kernel, c, line, &mut on_line);
         }
     }
 
@@ -202,6 +243,28 @@ impl<const RING: usize, const N: usize> Pipeline<RING, N> {
     pub fn set_lean_rho(&mut self, on: bool) {
         self.kernel.set_lean_rho(on);
     }
+}
+
+/// Runs the kernel on a complete line and counts its output.
+fn process_line<const N: usize>(
+    kernel: &mut Kernel<N>,
+    c: &mut PipelineCounters,
+    line: &mut Line<N>,
+    on_line: &mut impl FnMut(&ScanlineOutput<'_>),
+) {
+    let out = kernel.process(line);
+    let k = out.counters;
+    c.kernel_lines += 1;
+    c.kernel_points += u64::from(k.points_in);
+    c.kept += u64::from(k.kept);
+    c.irregular += u64::from(k.irregular);
+    c.no_neighbour += u64::from(k.no_neighbour);
+    c.non_finite += u64::from(k.non_finite);
+    c.outside_roi += u64::from(k.outside_roi);
+    c.peaks += u64::from(k.peaks);
+    c.left_candidates += u64::from(out.left.is_some());
+    c.right_candidates += u64::from(out.right.is_some());
+    on_line(&out);
 }
 
 impl<const RING: usize, const N: usize> Default for Pipeline<RING, N> {
