@@ -209,6 +209,24 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
         }
     }
 
+    /// The ingest [`Ingest::new`] gives, without rewriting the ring's bytes or the line's
+    /// arrays.
+    pub fn restart(&mut self) {
+        let Self {
+            cur,
+            next_seq,
+            finishing,
+            pending_config,
+            c,
+            asm,
+            ring,
+        } = self;
+        (*cur, *next_seq, *finishing, *pending_config) = (None, None, false, None);
+        *c = IngestCounters::ZERO;
+        asm.restart();
+        ring.restart();
+    }
+
     /// Sets the line-splitting parameters (from the next point on).
     pub fn set_split_params(&mut self, params: SplitParams) {
         self.asm.set_params(params);

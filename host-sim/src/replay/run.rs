@@ -269,7 +269,7 @@ pub fn encode_stream(
 std::thread_local! {
     /// The pipeline this thread ran its last chunk through: a stream runs a chunk every
     /// 2^14 points, and a fresh allocation per chunk has the kernel map and zero its few
-    /// MB again each time.
+    /// MB again each time (restarting it rewrites no buffer either).
     static PIPELINE: std::cell::Cell<Option<Box<HostPipeline>>> =
         const { std::cell::Cell::new(None) };
 }
@@ -278,7 +278,7 @@ std::thread_local! {
 fn take_pipeline() -> Box<HostPipeline> {
     match PIPELINE.take() {
         Some(mut p) => {
-            *p = HostPipeline::new();
+            p.restart();
             p
         }
         None => Box::default(),

@@ -74,7 +74,7 @@ pub enum Feed {
     Wire,
 }
 
-/// Runs `arcs` through `pipe` (reset first): the config with `kernel`, then each arc as one
+/// Runs `arcs` through `pipe` (restarted first): the config with `kernel`, then each arc as one
 /// line, in order. Arc a's wire time is (`first_arc` + a)·T (module docs). Every line the
 /// core completes goes to `on_line`. With [`Feed::Direct`] the counts' packets and bytes
 /// stay 0.
@@ -91,7 +91,7 @@ where
     A: IntoIterator<Item = I>,
     I: IntoIterator<Item = ArcPoint>,
 {
-    *pipe = ArcPipeline::new();
+    pipe.restart();
     if feed_by == Feed::Direct {
         return Ok(run_direct(pipe, kernel, sensor, first_arc, arcs, on_line));
     }
