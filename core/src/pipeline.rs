@@ -34,10 +34,13 @@
 //! assert_eq!(p.counters().kernel_points, 50);
 //! ```
 
-use crate::kernel::{Kernel, KernelParams, OutputMode, ParamsError, PointStatus, ScanlineOutput};
-use crate::scanline::{Ingest, IngestCounters, IngestEvent};
+use crate::kernel::{
+    Kernel, KernelParams, OutputMode, ParamsError, PointStatus, ScanlineOutput, CONFIG_WORDS,
+};
+use crate::scanline::{Ingest, IngestCounters, IngestEvent, Line, SplitReason};
 use crate::wire::{
-    CandidatesRepr, EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr, StreamEncoder,
+    CandidatesRepr, EncodeError, OutputColumns, OutputHeaderRepr, OutputPointRepr, PointRecord,
+    StreamEncoder,
 };
 
 /// Everything the pipeline counted: ingest's counters plus the kernel's, summed over lines,
@@ -97,24 +100,46 @@ impl<const RING: usize, const N: usize> Pipeline<RING, N> {
         Self {
             ingest: Ingest::new(),
             kernel: Kernel::new(KernelParams::DEFAULT),
-            c: PipelineCounters {
-                ingest: IngestCounters::ZERO,
-                kernel_lines: 0,
-                kernel_points: 0,
-                kept: 0,
-                irregular: 0,
-                no_neighbour: 0,
-                non_finite: 0,
-                outside_roi: 0,
-                peaks: 0,
-                left_candidates: 0,
-                right_candidates: 0,
-                configs_applied: 0,
-                configs_rejected: 0,
-                last_config_error: None,
-            },
+            c: Self::new_counters(),
             fresh: true,
         }
+    }
+
+    /// Every counter zero.
+    const fn new_counters() -> PipelineCounters {
+        PipelineCounters {
+            ingest: IngestCounters::ZERO,
+            kernel_lines: 0,
+            kernel_points: 0,
+            kept: 0,
+            irregular: 0,
+            no_neighbour: 0,
+            non_finite: 0,
+            outside_roi: 0,
+            peaks: 0,
+            left_candidates: 0,
+            right_candidates: 0,
+            configs_applied: 0,
+            configs_rejected: 0,
+            last_config_error: None,
+        }
+    }
+
+    /// The pipeline [`Pipeline::new`] gives, without rewriting its buffers (a few hundred KB
+    /// that a new pipeline zeroes): the host's replay restarts one pipeline per thread for
+    /// every chunk of points. Every buffer entry a stream reads is written by that stream
+    /// first, so a restarted pipeline gives what a new one does (tested).
+    pub fn restart(&mut self) {
+        let Self {
+            ingest,
+            kernel,
+            c,
+            fresh,
+        } = self;
+        ingest.restart();
+        kernel.restart(KernelParams::DEFAULT);
+        *c = Self::new_counters();
+        *fresh = true;
     }
 
     /// The ring's free space, for a DMA engine or a `read()` call to fill in place;
@@ -137,44 +162,82 @@ impl<const RING: usize, const N: usize> Pipeline<RING, N> {
     /// Processes every complete line in the ring, calling `on_line` with each result; a
     /// config packet reconfigures the kernel (bad ones are counted, the old parameters stay).
     pub fn run(&mut self, mut on_line: impl FnMut(&ScanlineOutput<'_>)) {
+        self.settle_split();
+        loop {
+            let Self {
+                ingest, kernel, c, ..
+            } = self;
+            match ingest.poll() {
+                None => break,
+                Some(IngestEvent::Config(words)) => self.apply_config(&words),
+                Some(IngestEvent::Line(line)) => process_line(kernel, c, line, &mut on_line),
+            }
+        }
+    }
+
+    /// Applies a config packet's parameter words: the kernel and the assembler take them
+    /// (from the next line on); bad ones are counted and the old parameters stay.
+    fn apply_config(&mut self, words: &[u32; CONFIG_WORDS]) {
+        match KernelParams::from_words(words).and_then(|p| self.kernel.set_params(p).map(|()| p)) {
+            Ok(p) => {
+                self.ingest.set_split_params(p.split_params());
+                self.c.configs_applied += 1;
+            }
+            Err(e) => {
+                self.c.configs_rejected += 1;
+                self.c.last_config_error = Some(e);
+            }
+        }
+    }
+
+    /// The assembler takes the kernel's split rules before it sees a point (see
+    /// [`Pipeline::new`]).
+    fn settle_split(&mut self) {
         if self.fresh {
             self.ingest
                 .set_split_params(self.kernel.params().split_params());
             self.fresh = false;
         }
-        while let Some(ev) = self.ingest.poll() {
-            match ev {
-                IngestEvent::Config(words) => {
-                    match KernelParams::from_words(&words)
-                        .and_then(|p| self.kernel.set_params(p).map(|()| p))
-                    {
-                        Ok(p) => {
-                            self.ingest.set_split_params(p.split_params());
-                            self.c.configs_applied += 1;
-                        }
-                        Err(e) => {
-                            self.c.configs_rejected += 1;
-                            self.c.last_config_error = Some(e);
-                        }
-                    }
-                }
-                IngestEvent::Line(line) => {
-                    let out = self.kernel.process(line);
-                    let k = out.counters;
-                    let c = &mut self.c;
-                    c.kernel_lines += 1;
-                    c.kernel_points += u64::from(k.points_in);
-                    c.kept += u64::from(k.kept);
-                    c.irregular += u64::from(k.irregular);
-                    c.no_neighbour += u64::from(k.no_neighbour);
-                    c.non_finite += u64::from(k.non_finite);
-                    c.outside_roi += u64::from(k.outside_roi);
-                    c.peaks += u64::from(k.peaks);
-                    c.left_candidates += u64::from(out.left.is_some());
-                    c.right_candidates += u64::from(out.right.is_some());
-                    on_line(&out);
-                }
-            }
+    }
+
+    /// A config packet's words given directly, without their packet: the line being
+    /// assembled is completed and processed first, then the words apply as
+    /// [`Pipeline::run`] applies a config packet's. With [`Pipeline::push_point`] this is
+    /// the core fed by a caller that holds decoded points (host-sim's replay), skipping
+    /// the bytes, the CRC and the parse; the assembler, the split rules and the kernel are
+    /// the same code, so the lines and their output are too.
+    pub fn push_config(
+        &mut self,
+        words: &[u32; CONFIG_WORDS],
+        mut on_line: impl FnMut(&ScanlineOutput<'_>),
+    ) {
+        self.settle_split();
+        let Self {
+            ingest, kernel, c, ..
+        } = self;
+        if let Some(line) = ingest.close_line(SplitReason::Config) {
+            process_line(kernel, c, line, &mut on_line);
+        }
+        self.apply_config(words);
+    }
+
+    /// One point given directly, at absolute time `t_ns`, as ingest hands a parsed record
+    /// of a points packet to the assembler (a non-finite x′ or z′ is counted and dropped,
+    /// as ingest drops such a record); a line it completes is processed and given to
+    /// `on_line` first. `p.dt_ns` is not read. See [`Pipeline::push_config`].
+    #[inline]
+    pub fn push_point(
+        &mut self,
+        t_ns: u64,
+        p: &PointRecord,
+        mut on_line: impl FnMut(&ScanlineOutput<'_>),
+    ) {
+        self.settle_split();
+        let Self {
+            ingest, kernel, c, ..
+        } = self;
+        while let Some(line) = ingest.offer_point(t_ns, p) {
+            process_line(kernel, c, line, &mut on_line);
         }
     }
 
@@ -202,6 +265,28 @@ impl<const RING: usize, const N: usize> Pipeline<RING, N> {
     pub fn set_lean_rho(&mut self, on: bool) {
         self.kernel.set_lean_rho(on);
     }
+}
+
+/// Runs the kernel on a complete line and counts its output.
+fn process_line<const N: usize>(
+    kernel: &mut Kernel<N>,
+    c: &mut PipelineCounters,
+    line: &mut Line<N>,
+    on_line: &mut impl FnMut(&ScanlineOutput<'_>),
+) {
+    let out = kernel.process(line);
+    let k = out.counters;
+    c.kernel_lines += 1;
+    c.kernel_points += u64::from(k.points_in);
+    c.kept += u64::from(k.kept);
+    c.irregular += u64::from(k.irregular);
+    c.no_neighbour += u64::from(k.no_neighbour);
+    c.non_finite += u64::from(k.non_finite);
+    c.outside_roi += u64::from(k.outside_roi);
+    c.peaks += u64::from(k.peaks);
+    c.left_candidates += u64::from(out.left.is_some());
+    c.right_candidates += u64::from(out.right.is_some());
+    on_line(&out);
 }
 
 impl<const RING: usize, const N: usize> Default for Pipeline<RING, N> {
@@ -470,6 +555,128 @@ mod tests {
             c.kept + c.irregular + c.no_neighbour + c.non_finite + c.outside_roi,
             600
         );
+    }
+
+    /// What a line's output holds, owned.
+    type Seen = (
+        u32,
+        u64,
+        u32,
+        Vec<u32>,
+        Vec<f32>,
+        Vec<f32>,
+        Vec<f32>,
+        Vec<PointStatus>,
+    );
+
+    fn seen(o: &ScanlineOutput<'_>) -> Seen {
+        (
+            o.index,
+            o.start_time_ns,
+            o.params_hash,
+            o.tag.to_vec(),
+            o.x_m.to_vec(),
+            o.z_m.to_vec(),
+            o.rho_deg.to_vec(),
+            o.status.to_vec(),
+        )
+    }
+
+    /// A restarted pipeline runs a stream as a new one does, after a stream that left a
+    /// config applied, a line half assembled and bytes in the ring.
+    #[test]
+    fn a_restarted_pipeline_runs_like_a_new_one() {
+        let mut enc = StreamEncoder::new();
+        let mut buf = [0u8; MAX_PACKET_LEN];
+        let other = KernelParams {
+            d_b_m: 0.05,
+            ..KernelParams::DEFAULT
+        };
+        let n = enc.encode_config(&other.to_words(), &mut buf).unwrap();
+        let mut before = buf[..n].to_vec();
+        stream(&mut enc, 3, &mut before);
+        let mut p = std::boxed::Box::new(Pipeline::<RING, N>::new());
+        p.write(&before[..before.len() - 700]);
+        p.run(|_| {});
+        assert!(p.counters().ingest.points_pending > 0 && p.ingest.buffered() > 0);
+        p.restart();
+        let mut fresh = std::boxed::Box::new(Pipeline::<RING, N>::new());
+        let mut after = Vec::new();
+        stream(&mut StreamEncoder::new(), 2, &mut after);
+        let mut outs = [Vec::new(), Vec::new()];
+        for (q, out) in [&mut p, &mut fresh].into_iter().zip(&mut outs) {
+            assert_eq!(q.write(&after), after.len());
+            q.finish(|o| out.push(seen(o)));
+        }
+        assert_eq!(outs[0].len(), 2);
+        assert_eq!(outs[0], outs[1]);
+        assert_eq!(p.counters(), fresh.counters());
+        assert_eq!(p.params(), fresh.params());
+    }
+
+    /// Points and config words given directly give the lines and the kernel's output of
+    /// the same points sent as packets.
+    #[test]
+    fn points_given_directly_are_the_packets_lines() {
+        let other = KernelParams {
+            d_b_m: 0.05,
+            ..KernelParams::DEFAULT
+        };
+        let mut enc = StreamEncoder::new();
+        let mut buf = [0u8; MAX_PACKET_LEN];
+        let n = enc.encode_config(&other.to_words(), &mut buf).unwrap();
+        let mut bytes = buf[..n].to_vec();
+        stream(&mut enc, 3, &mut bytes);
+        let mut wire = std::boxed::Box::new(Pipeline::<RING, N>::new());
+        let mut by_wire = Vec::new();
+        for chunk in bytes.chunks(1000) {
+            assert_eq!(wire.write(chunk), chunk.len());
+            wire.run(|o| by_wire.push(seen(o)));
+        }
+        wire.finish(|o| by_wire.push(seen(o)));
+
+        // The same records, parsed back out of the bytes, given one by one.
+        let mut direct = std::boxed::Box::new(Pipeline::<RING, N>::new());
+        let mut by_point = Vec::new();
+        let mut at = 0;
+        while at < bytes.len() {
+            let Scan::Packet { len, .. } = scan(&bytes[at..], true) else {
+                panic!("no packet at {at}");
+            };
+            let pk = Packet::new_checked(&bytes[at..at + len]).unwrap();
+            if pk.kind() == Some(PacketKind::Config) {
+                direct.push_config(&other.to_words(), |o| by_point.push(seen(o)));
+            } else {
+                let pts = crate::wire::PointsRepr::parse(&pk).unwrap();
+                for r in &pts.points {
+                    let t = pts.base_time_ns + u64::from(r.dt_ns);
+                    direct.push_point(t, r, |o| by_point.push(seen(o)));
+                }
+            }
+            at += len;
+        }
+        direct.finish(|o| by_point.push(seen(o)));
+        assert_eq!(by_wire.len(), 3);
+        assert_eq!(by_point, by_wire);
+        let (d, w) = (direct.counters(), wire.counters());
+        assert_eq!(
+            (d.kernel_points, d.kept, d.configs_applied),
+            (900, w.kept, 1)
+        );
+        assert_eq!(d.ingest.points_in_lines, w.ingest.points_in_lines);
+        // A non-finite point is counted and dropped, as ingest drops such a record.
+        let mut p = std::boxed::Box::new(Pipeline::<RING, N>::new());
+        let bad = PointRecord {
+            dt_ns: 0,
+            x_m: f32::NAN,
+            z_m: -2.0,
+            intensity: 0,
+            line_start: true,
+            tag: 0,
+        };
+        p.push_point(1_000, &bad, |_| panic!("no line"));
+        p.finish(|_| panic!("no line"));
+        assert_eq!(p.counters().ingest.points_non_finite, 1);
     }
 
     #[test]

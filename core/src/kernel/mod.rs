@@ -242,6 +242,29 @@ impl<const N: usize> Kernel<N> {
         }
     }
 
+    /// The kernel [`Kernel::new`]`(params)` gives, without rewriting its per-point buffers:
+    /// a line writes every entry it reads (the kernel holds no state across lines).
+    pub fn restart(&mut self, params: KernelParams) {
+        let Self {
+            params: p,
+            params_hash,
+            derived,
+            rho: _,
+            status: _,
+            aux: _,
+            s_off: _,
+            deque: _,
+            exact: _,
+            fresh,
+            lean_rho,
+        } = self;
+        *p = params;
+        *params_hash = 0;
+        *derived = Derived::PENDING;
+        *fresh = true;
+        *lean_rho = false;
+    }
+
     /// The parameters in force.
     pub fn params(&self) -> &KernelParams {
         &self.params

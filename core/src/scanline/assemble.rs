@@ -216,6 +216,32 @@ impl<const N: usize> Assembler<N> {
         }
     }
 
+    /// The assembler [`Assembler::new`] gives, without rewriting the line's arrays (only
+    /// its first `len` points are ever read).
+    pub fn restart(&mut self) {
+        let Self {
+            closed,
+            reset,
+            armed,
+            seen_flag,
+            vote,
+            last_pt,
+            last_side_pt,
+            last_t,
+            params,
+            next_index,
+            counters,
+            line,
+        } = self;
+        (*closed, *reset, *armed, *seen_flag) = (false, false, true, false);
+        *vote = 0;
+        (*last_pt, *last_side_pt, *last_t) = (None, None, None);
+        *params = SplitParams::DEFAULT;
+        *next_index = 0;
+        *counters = AssembleCounters::default();
+        line.clear();
+    }
+
     /// The split parameters in force.
     pub fn params(&self) -> SplitParams {
         self.params

@@ -209,6 +209,24 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
         }
     }
 
+    /// The ingest [`Ingest::new`] gives, without rewriting the ring's bytes or the line's
+    /// arrays.
+    pub fn restart(&mut self) {
+        let Self {
+            cur,
+            next_seq,
+            finishing,
+            pending_config,
+            c,
+            asm,
+            ring,
+        } = self;
+        (*cur, *next_seq, *finishing, *pending_config) = (None, None, false, None);
+        *c = IngestCounters::ZERO;
+        asm.restart();
+        ring.restart();
+    }
+
     /// Sets the line-splitting parameters (from the next point on).
     pub fn set_split_params(&mut self, params: SplitParams) {
         self.asm.set_params(params);
@@ -269,6 +287,39 @@ impl<const RING: usize, const N: usize> Ingest<RING, N> {
             split_config: a.split_config,
             split_end: a.split_end,
             ..self.c
+        }
+    }
+
+    /// A point given directly instead of in a points packet (at absolute time `t_ns`; its
+    /// `dt_ns` is not read): counted and assembled as a parsed record of the ring is, a
+    /// non-finite x′ or z′ counted and dropped. Returns the line the point completes, which
+    /// stays valid until the next call; offer the same point again until it returns `None`
+    /// (the point then opens or continues the next line). The ring must be empty, with
+    /// no packet being read: a stream is fed either as bytes or point by point.
+    #[inline]
+    pub fn offer_point(&mut self, t_ns: u64, p: &PointRecord) -> Option<&mut Line<N>> {
+        debug_assert!(self.cur.is_none() && self.ring.is_empty());
+        if !p.x_m.is_finite() || !p.z_m.is_finite() {
+            self.c.points_in += 1;
+            self.c.points_non_finite += 1;
+            return None;
+        }
+        match self.asm.offer(t_ns, p) {
+            Offer::Taken => {
+                self.c.points_in += 1;
+                None
+            }
+            Offer::Split(_) => Some(self.asm.line_mut()),
+        }
+    }
+
+    /// Ends the line being assembled from outside (as a config packet does, for
+    /// [`Self::offer_point`]'s callers); returns it if it held points.
+    pub fn close_line(&mut self, reason: SplitReason) -> Option<&mut Line<N>> {
+        if self.asm.close(reason) {
+            Some(self.asm.line_mut())
+        } else {
+            None
         }
     }
 

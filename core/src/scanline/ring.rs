@@ -34,6 +34,18 @@ impl<const CAP: usize> Ring<CAP> {
         }
     }
 
+    /// Empties the ring as [`Ring::new`] leaves it, without rewriting its bytes (no byte
+    /// is read before it is written again).
+    pub fn restart(&mut self) {
+        let Self {
+            head,
+            len,
+            dropped,
+            buf: _,
+        } = self;
+        (*head, *len, *dropped) = (0, 0, 0);
+    }
+
     /// The capacity in bytes.
     pub const fn capacity(&self) -> usize {
         CAP

@@ -6,7 +6,7 @@
 //!   without a lookup.
 
 use crate::io::sweep::Sweep;
-use crate::rings::run::{self as arc_run, ArcPipeline, ArcPoint, ArcRunError};
+use crate::rings::run::{self as arc_run, ArcPipeline, ArcPoint, ArcRunError, Feed};
 use crate::rings::{project, HalfArc, SensorModel};
 use curbtrace_core::kernel::{KernelParams, ScanlineOutput};
 
@@ -76,6 +76,6 @@ pub fn run_arcs(
             }
         })
     });
-    arc_run::run_arcs(pipe, params, sensor, 0, points, &mut collect)?;
+    arc_run::run_arcs(pipe, params, sensor, 0, points, Feed::Direct, &mut collect)?;
     Ok(out)
 }

@@ -1,7 +1,17 @@
-//! The points, projected, encoded into the wire format and run through
-//! `curbtrace_core::Pipeline` in-process: the same bytes the firmware would see
-//! (a config packet first, then point packets with the absolute GPS time in ns as each
-//! packet's base and the column index as each point's tag).
+//! The points, projected and run through `curbtrace_core::Pipeline` in-process: the
+//! kernel's parameter words first, then every point with its absolute GPS time in ns and
+//! the column index as its tag.
+//!
+//! # Direct or through the wire
+//!
+//! By default ([`ReplayParams::wire`] off) each point goes straight to the core's line
+//! assembly (`Pipeline::push_config`, `Pipeline::push_point`): the assembler, its split
+//! rules and the kernel are the code the firmware runs, without the bytes. With `wire` on,
+//! the points are encoded into the wire format the firmware reads (a config packet, then
+//! point packets with the first point's GPS time in ns as each packet's base) and the core
+//! parses them back, CRC and all ([`encode_stream`]). Both give the same lines and the
+//! same output bit for bit (`tests/replay_direct.rs`); the direct path saves the encoding,
+//! the CRC and the parse (docs/benchmarks.md).
 //!
 //! # Parallel replay, identical output
 //!
@@ -55,6 +65,9 @@ pub struct ReplayParams {
     /// chunks mean fewer pipelines; smaller ones balance threads better. 2^18 keeps the
     /// two cores here busy on 5 M points with 20 chunks.
     pub chunk_points: usize,
+    /// Send the points through the wire format (encoded, CRC, parsed back) instead of
+    /// straight to the core's line assembly; the output is the same (module docs).
+    pub wire: bool,
 }
 
 impl Default for ReplayParams {
@@ -64,6 +77,7 @@ impl Default for ReplayParams {
             wrap_min_deg: l.wrap_min_deg,
             line_period_s: l.line_period_s,
             chunk_points: 1 << 18,
+            wire: false,
         }
     }
 }
@@ -255,7 +269,7 @@ pub fn encode_stream(
 std::thread_local! {
     /// The pipeline this thread ran its last chunk through: a stream runs a chunk every
     /// 2^14 points, and a fresh allocation per chunk has the kernel map and zero its few
-    /// MB again each time.
+    /// MB again each time (restarting it rewrites no buffer either).
     static PIPELINE: std::cell::Cell<Option<Box<HostPipeline>>> =
         const { std::cell::Cell::new(None) };
 }
@@ -264,7 +278,7 @@ std::thread_local! {
 fn take_pipeline() -> Box<HostPipeline> {
     match PIPELINE.take() {
         Some(mut p) => {
-            *p = HostPipeline::new();
+            p.restart();
             p
         }
         None => Box::default(),
@@ -285,12 +299,46 @@ struct ChunkSlices<'a> {
     line: &'a mut [u32],
 }
 
+/// Point `i` as the core's assembler takes it on the direct path: its time in ns and the
+/// record [`encode_stream`] would have sent (`dt_ns` unused). A coordinate that is not
+/// finite as `f32` is the error the encoder gives on the wire path.
+#[inline]
+fn direct_point(
+    cols: &PointColumns,
+    i: usize,
+    cur: &mut PoseCursor<'_>,
+    rule: &LineRule,
+) -> Result<(u64, PointRecord), ReplayError> {
+    let t = cols.t[i];
+    let t_ns = ns_of(t, i)?;
+    let (xp, zp) = project_point(cur, cols.x[i], cols.y[i], cols.z[i], t)
+        .ok_or(ReplayError::Uncovered { index: i, t })?;
+    let (x_m, z_m) = (xp as f32, zp as f32);
+    if !x_m.is_finite() || !z_m.is_finite() {
+        return Err(ReplayError::Encode(
+            curbtrace_core::wire::EncodeError::NonFinite { index: i },
+        ));
+    }
+    Ok((
+        t_ns,
+        PointRecord {
+            dt_ns: 0,
+            x_m,
+            z_m,
+            intensity: cols.intensity[i],
+            line_start: rule.is_start(i, &cols.scan_angle_deg, &cols.t),
+            tag: i as u32,
+        },
+    ))
+}
+
 fn run_chunk(
     cols: &PointColumns,
     range: Range<usize>,
     traj: &Trajectory,
     words: &[u32; CONFIG_WORDS],
     rule: &LineRule,
+    wire: bool,
     slices: ChunkSlices<'_>,
 ) -> Result<ChunkOut, ReplayError> {
     let ChunkSlices { rho, status, line } = slices;
@@ -326,31 +374,40 @@ fn run_chunk(
             }
         }
     };
-    let mut packets = 0u64;
-    let mut bytes = 0u64;
-    encode_stream(cols, range.clone(), traj, words, rule, &mut |b: &[u8]| {
-        packets += 1;
-        bytes += b.len() as u64;
-        let mut off = 0;
-        while off < b.len() {
-            let w = pipe.write(&b[off..]);
-            off += w;
-            pipe.run(|o| collect(o, &mut out));
-            if w == 0 && off < b.len() {
-                // The ring is full and processing every complete line freed nothing.
-                let w2 = pipe.write(&b[off..]);
-                if w2 == 0 {
-                    return Err(ReplayError::Stalled);
+    if wire {
+        let mut packets = 0u64;
+        let mut bytes = 0u64;
+        encode_stream(cols, range.clone(), traj, words, rule, &mut |b: &[u8]| {
+            packets += 1;
+            bytes += b.len() as u64;
+            let mut off = 0;
+            while off < b.len() {
+                let w = pipe.write(&b[off..]);
+                off += w;
+                pipe.run(|o| collect(o, &mut out));
+                if w == 0 && off < b.len() {
+                    // The ring is full and processing every complete line freed nothing.
+                    let w2 = pipe.write(&b[off..]);
+                    if w2 == 0 {
+                        return Err(ReplayError::Stalled);
+                    }
+                    off += w2;
                 }
-                off += w2;
             }
+            Ok(())
+        })?;
+        out.counters.packets = packets;
+        out.counters.bytes = bytes;
+    } else {
+        pipe.push_config(words, |o| collect(o, &mut out));
+        let mut cur = PoseCursor::new(traj);
+        for i in range.clone() {
+            let p = direct_point(cols, i, &mut cur, rule)?;
+            pipe.push_point(p.0, &p.1, |o| collect(o, &mut out));
         }
-        Ok(())
-    })?;
+    }
     pipe.finish(|o| collect(o, &mut out));
     PIPELINE.set(Some(pipe));
-    out.counters.packets = packets;
-    out.counters.bytes = bytes;
     out.counters.points_sent = range.len() as u64;
     Ok(out)
 }
@@ -429,6 +486,7 @@ pub fn run_kernel_with_rule(
                     traj,
                     words,
                     &rule,
+                    params.wire,
                     ChunkSlices {
                         rho: r,
                         status: s,

@@ -1,9 +1,12 @@
-//! Half-arcs through the core: encoded into the wire format (a config packet with the
-//! sensor's kernel parameters first, then point packets) and run through
-//! `curbtrace_core::Pipeline` in-process, the code the firmware runs. The single-frame job
-//! (`frame::run`) and the stream's ring stage (`stream::ring_stage`) both send their arcs
-//! through [`run_arcs`].
+//! Half-arcs through the core: run through `curbtrace_core::Pipeline` in-process, the code
+//! the firmware runs — the sensor's kernel parameters first, then the points. The
+//! single-frame job (`frame::run`) and the stream's ring stage (`stream::ring_stage`) both
+//! send their arcs through [`run_arcs`].
 //!
+//! - [`Feed::Direct`] hands each point straight to the core's line assembly
+//!   (`Pipeline::push_point`); [`Feed::Wire`] encodes them into the wire format (a config
+//!   packet, then point packets) for the core to parse back, CRC and all. The lines and
+//!   their output are the same either way (`replay::run`'s module docs).
 //! - Each half-arc is one line: its first point carries the line-start flag, and the
 //!   parameters split lines on nothing else (see [`super::SensorModel::kernel_params`]).
 //! - Wire times are nominal: point k of arc a is at a·T + k·δt (T the revolution, δt the
@@ -61,22 +64,37 @@ pub struct WireCounts {
     pub points: u64,
 }
 
-/// Runs `arcs` through `pipe` (reset first): the config packet with `kernel`, then each arc
-/// as one line, in order. Arc a's wire time is (`first_arc` + a)·T (module docs). Every
-/// line the core completes goes to `on_line`.
+/// How points reach the core (module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Feed {
+    /// Straight to the core's line assembly.
+    #[default]
+    Direct,
+    /// Encoded into wire packets and parsed back by the core.
+    Wire,
+}
+
+/// Runs `arcs` through `pipe` (restarted first): the config with `kernel`, then each arc as one
+/// line, in order. Arc a's wire time is (`first_arc` + a)·T (module docs). Every line the
+/// core completes goes to `on_line`. With [`Feed::Direct`] the counts' packets and bytes
+/// stay 0.
 pub fn run_arcs<A, I>(
     pipe: &mut ArcPipeline,
     kernel: &KernelParams,
     sensor: &SensorModel,
     first_arc: u64,
     arcs: A,
+    feed_by: Feed,
     on_line: &mut impl FnMut(&ScanlineOutput<'_>),
 ) -> Result<WireCounts, ArcRunError>
 where
     A: IntoIterator<Item = I>,
     I: IntoIterator<Item = ArcPoint>,
 {
-    *pipe = ArcPipeline::new();
+    pipe.restart();
+    if feed_by == Feed::Direct {
+        return Ok(run_direct(pipe, kernel, sensor, first_arc, arcs, on_line));
+    }
     let mut enc = StreamEncoder::new();
     let mut buf = vec![0u8; MAX_PACKET_LEN];
     let mut sent = WireCounts::default();
@@ -86,9 +104,7 @@ where
     feed(pipe, &buf[..n], on_line)?;
     sent.packets += 1;
     sent.bytes += n as u64;
-    let rate_hz = sensor.rate_hz.max(0.1);
-    let period_ns = (1e9 / rate_hz) as u64;
-    let step_ns = ((sensor.azimuth_step_deg / 360.0) * 1e9 / rate_hz).max(1.0) as u32;
+    let (period_ns, step_ns) = arc_timing(sensor);
     let mut recs: Vec<PointRecord> = Vec::with_capacity(MAX_POINTS_PER_PACKET);
     for (a, arc) in arcs.into_iter().enumerate() {
         let t_arc = (first_arc + a as u64) * period_ns;
@@ -128,6 +144,49 @@ where
     }
     pipe.finish(&mut *on_line);
     Ok(sent)
+}
+
+/// [`run_arcs`] with [`Feed::Direct`]: each point at the time the wire path gives it.
+fn run_direct<A, I>(
+    pipe: &mut ArcPipeline,
+    kernel: &KernelParams,
+    sensor: &SensorModel,
+    first_arc: u64,
+    arcs: A,
+    on_line: &mut impl FnMut(&ScanlineOutput<'_>),
+) -> WireCounts
+where
+    A: IntoIterator<Item = I>,
+    I: IntoIterator<Item = ArcPoint>,
+{
+    let mut sent = WireCounts::default();
+    pipe.push_config(&kernel.to_words(), &mut *on_line);
+    let (period_ns, step_ns) = arc_timing(sensor);
+    for (a, arc) in arcs.into_iter().enumerate() {
+        let t_arc = (first_arc + a as u64) * period_ns;
+        for (k, p) in arc.into_iter().enumerate() {
+            let rec = PointRecord {
+                dt_ns: 0,
+                x_m: p.x_m,
+                z_m: p.z_m,
+                intensity: p.intensity,
+                line_start: k == 0,
+                tag: p.tag,
+            };
+            pipe.push_point(t_arc + k as u64 * u64::from(step_ns), &rec, &mut *on_line);
+            sent.points += 1;
+        }
+    }
+    pipe.finish(&mut *on_line);
+    sent
+}
+
+/// The revolution T and the time δt between two firings of one laser, ns (module docs).
+fn arc_timing(sensor: &SensorModel) -> (u64, u32) {
+    let rate_hz = sensor.rate_hz.max(0.1);
+    let period_ns = (1e9 / rate_hz) as u64;
+    let step_ns = ((sensor.azimuth_step_deg / 360.0) * 1e9 / rate_hz).max(1.0) as u32;
+    (period_ns, step_ns)
 }
 
 /// Writes `b` into the pipeline, processing complete lines whenever the ring is full.

@@ -457,7 +457,9 @@ impl<'a> Stage<'a> {
         rings: bool,
     ) -> Self {
         if rings {
-            Stage::Rings(Box::new(ring_stage::RingStage::new(traj, cfg.rings, None)))
+            Stage::Rings(Box::new(
+                ring_stage::RingStage::new(traj, cfg.rings, None).through_wire(cfg.replay.wire),
+            ))
         } else {
             Stage::Lines(Box::new(core_stage::CoreStage::new(
                 traj, *words, cfg.replay,

@@ -27,7 +27,7 @@ use crate::model::Side;
 use crate::replay::project::PoseCursor;
 use crate::replay::run::{ReplayCounters, ReplayError};
 use crate::replay::{Candidate, PointStatus};
-use crate::rings::run::{self as arc_run, ArcPipeline, ArcPoint, ArcRunError};
+use crate::rings::run::{self as arc_run, ArcPipeline, ArcPoint, ArcRunError, Feed};
 use crate::rings::{project, ArcCounters, ArcParams, SensorModel};
 use crate::source::PointBatch;
 use curbtrace_core::kernel::{KernelParams, ScanlineOutput};
@@ -228,6 +228,8 @@ pub struct RingStage<'a> {
     next_base: u64,
     lines: u32,
     pipe: Box<ArcPipeline>,
+    /// How the half-arcs reach the core.
+    feed: Feed,
     /// Counters summed over the stream.
     pub counters: ReplayCounters,
     /// The half-arc cut's counters summed over the stream.
@@ -257,12 +259,20 @@ impl<'a> RingStage<'a> {
             next_base: 0,
             lines: 0,
             pipe: Box::new(ArcPipeline::new()),
+            feed: Feed::Direct,
             counters: ReplayCounters::default(),
             arcs: ArcCounters::default(),
             rings_seen: [0; 4],
             intake: Intake::new(traj),
             points: 0,
         }
+    }
+
+    /// Sends the half-arcs through the wire format ([`Feed::Wire`]) when `wire`, straight
+    /// to the core's line assembly otherwise (the default); the output is the same.
+    pub fn through_wire(mut self, wire: bool) -> Self {
+        self.feed = if wire { Feed::Wire } else { Feed::Direct };
+        self
     }
 
     /// The half-arc cut's counters so far, with the rings seen.
@@ -555,6 +565,7 @@ impl<'a> RingStage<'a> {
             sensor,
             u64::from(base_line) + 1,
             points,
+            self.feed,
             &mut collect,
         )
         .map_err(|e| match e {
