@@ -161,7 +161,9 @@ pub fn extract_edges_on_grid(
         .map_or(0, |m| m.saturating_add(1))
         .max(input.x.len() as u32);
     let tracks = bridge::bridge_tracks(&input, grid, tracks, next_id, params);
-    postfilter::to_edge_lines_with_steps(&input, grid, route, &tracks, params)
+    postfilter::remove_tall_steps(postfilter::to_edge_lines_with_steps(
+        &input, grid, route, &tracks, params,
+    ))
 }
 
 /// The median of `v` (reordered in place), `None` when empty.
