@@ -98,13 +98,20 @@ pub fn extract_edges_with_steps(
 }
 
 /// [`extract_edges_with_steps`] on a route built once from `input.trajectory` (a stream
-/// runs many windows over one trajectory).
+/// runs many windows over one trajectory). Filter 4 ([`postfilter::remove_tall_steps`])
+/// runs here on whole edges; a stream runs it where its pieces are joined, on the median
+/// over the whole edge (`stream::merge`).
 pub fn extract_edges_on_route(
     input: &BendInput,
     route: &route::Route,
     params: &BendParams,
 ) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
-    extract_edges_on_grid(input, &point_grid(input, params), route, params)
+    postfilter::remove_tall_steps(extract_edges_on_grid(
+        input,
+        &point_grid(input, params),
+        route,
+        params,
+    ))
 }
 
 /// The one index over every processed point that the tracker and the curb annotation
@@ -161,9 +168,7 @@ pub fn extract_edges_on_grid(
         .map_or(0, |m| m.saturating_add(1))
         .max(input.x.len() as u32);
     let tracks = bridge::bridge_tracks(&input, grid, tracks, next_id, params);
-    postfilter::remove_tall_steps(postfilter::to_edge_lines_with_steps(
-        &input, grid, route, &tracks, params,
-    ))
+    postfilter::to_edge_lines_with_steps(&input, grid, route, &tracks, params)
 }
 
 /// The median of `v` (reordered in place), `None` when empty.

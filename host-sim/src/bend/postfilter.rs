@@ -391,7 +391,7 @@ pub fn to_edge_lines_with_steps(
 /// streets' reach 0.25 m, high curbs 0.3 m), below the roof of a car beside its side.
 pub const MAX_CURB_STEP_M: f64 = 0.5;
 
-/// Filter 4: removes the stretches (output lines of [`to_edge_lines_with_steps`]) whose
+/// Filter 4: removes the stretches (whole output lines of [`to_edge_lines_with_steps`]) whose
 /// median height step exceeds [`MAX_CURB_STEP_M`]. Such a line follows the side of a
 /// vehicle the scanner sees from above (the road up to its foot, its roof beyond, its side
 /// hidden, so filter 2 finds nothing above the line), not a curb. Lines without a measured
@@ -399,10 +399,14 @@ pub const MAX_CURB_STEP_M: f64 = 0.5;
 pub fn remove_tall_steps(
     lines: Vec<(EdgeLine, Vec<Option<f64>>)>,
 ) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
-    lines
-        .into_iter()
-        .filter(|(e, _)| !matches!(e.curb_height_m, Some(h) if h > MAX_CURB_STEP_M))
-        .collect()
+    lines.into_iter().filter(|(e, _)| !tall_step(e)).collect()
+}
+
+/// Whether `e`'s median height step exceeds [`MAX_CURB_STEP_M`] (filter 4). A piece of an
+/// edge cut at a section's bound is judged only once joined: its own median may be
+/// another stretch's.
+pub fn tall_step(e: &EdgeLine) -> bool {
+    matches!(e.curb_height_m, Some(h) if h > MAX_CURB_STEP_M)
 }
 
 /// The position of the ρ peak at point `p`: the vertex of the parabola through ρ of `p`
@@ -532,6 +536,7 @@ pub fn category_runs(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::Side;
 
     #[test]
     fn crossing_segments() {
@@ -618,12 +623,6 @@ mod tests {
         };
         assert_eq!(refined_pos(&input, 1), [0.02, 0.0, 1.0]);
     }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::model::Side;
 
     fn line(step: Option<f64>) -> (EdgeLine, Vec<Option<f64>>) {
         let e = EdgeLine {
