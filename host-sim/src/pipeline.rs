@@ -506,10 +506,12 @@ fn extract_and_annotate(
 ) -> Vec<crate::model::EdgeLine> {
     let route = bend::route::Route::new(input.trajectory);
     let grid = bend::point_grid(input, params);
-    let mut edges: Vec<_> = bend::extract_edges_on_grid(input, &grid, &route, params)
-        .into_iter()
-        .map(|(e, _)| e)
-        .collect();
+    let mut edges: Vec<_> = bend::postfilter::remove_tall_steps(bend::extract_edges_on_grid(
+        input, &grid, &route, params,
+    ))
+    .into_iter()
+    .map(|(e, _)| e)
+    .collect();
     crate::curb::annotate(input, &grid, &route, edges.iter_mut());
     edges
 }

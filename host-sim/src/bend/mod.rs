@@ -98,13 +98,20 @@ pub fn extract_edges_with_steps(
 }
 
 /// [`extract_edges_with_steps`] on a route built once from `input.trajectory` (a stream
-/// runs many windows over one trajectory).
+/// runs many windows over one trajectory). Filter 4 ([`postfilter::remove_tall_steps`])
+/// runs here on whole edges; a stream runs it where its pieces are joined, on the median
+/// over the whole edge (`stream::merge`).
 pub fn extract_edges_on_route(
     input: &BendInput,
     route: &route::Route,
     params: &BendParams,
 ) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
-    extract_edges_on_grid(input, &point_grid(input, params), route, params)
+    postfilter::remove_tall_steps(extract_edges_on_grid(
+        input,
+        &point_grid(input, params),
+        route,
+        params,
+    ))
 }
 
 /// The one index over every processed point that the tracker and the curb annotation

@@ -10,6 +10,9 @@
 //! Then each edge gets its height step (median of the per-point steps across it) and a
 //! category per stretch (curb, curb cut by a small step, intersection by turning away
 //! from the trajectory's heading).
+//!
+//! 4. Stretches whose height step is taller than any curb are removed (see
+//!    [`remove_tall_steps`]).
 
 use super::grid::PointGrid;
 use super::params::BendParams;
@@ -384,6 +387,28 @@ pub fn to_edge_lines_with_steps(
     out
 }
 
+/// Tallest median height step of an output stretch, metres: above every curb (the random
+/// streets' reach 0.25 m, high curbs 0.3 m), below the roof of a car beside its side.
+pub const MAX_CURB_STEP_M: f64 = 0.5;
+
+/// Filter 4: removes the stretches (whole output lines of [`to_edge_lines_with_steps`]) whose
+/// median height step exceeds [`MAX_CURB_STEP_M`]. Such a line follows the side of a
+/// vehicle the scanner sees from above (the road up to its foot, its roof beyond, its side
+/// hidden, so filter 2 finds nothing above the line), not a curb. Lines without a measured
+/// step stay.
+pub fn remove_tall_steps(
+    lines: Vec<(EdgeLine, Vec<Option<f64>>)>,
+) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
+    lines.into_iter().filter(|(e, _)| !tall_step(e)).collect()
+}
+
+/// Whether `e`'s median height step exceeds [`MAX_CURB_STEP_M`] (filter 4). A piece of an
+/// edge cut at a section's bound is judged only once joined: its own median may be
+/// another stretch's.
+pub fn tall_step(e: &EdgeLine) -> bool {
+    matches!(e.curb_height_m, Some(h) if h > MAX_CURB_STEP_M)
+}
+
 /// The position of the ρ peak at point `p`: the vertex of the parabola through ρ of `p`
 /// and its neighbours on the same scanline (adjacent in time order), at most half-way to
 /// a neighbour; `p` itself where that is not defined.
@@ -511,6 +536,7 @@ pub fn category_runs(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::Side;
 
     #[test]
     fn crossing_segments() {
@@ -596,5 +622,29 @@ mod tests {
             ..input
         };
         assert_eq!(refined_pos(&input, 1), [0.02, 0.0, 1.0]);
+    }
+
+    fn line(step: Option<f64>) -> (EdgeLine, Vec<Option<f64>>) {
+        let e = EdgeLine {
+            points: vec![[0.0, 0.0, 0.0], [3.0, 0.0, 0.0]],
+            side: Side::Right,
+            category: Some(Category::Curb),
+            method: Some("bend".to_string()),
+            curb_height_m: step,
+            detail: None,
+        };
+        (e, vec![step, step])
+    }
+
+    #[test]
+    fn a_step_taller_than_any_curb_is_not_a_curb() {
+        let kept = remove_tall_steps(vec![
+            line(Some(0.29)),
+            line(Some(1.42)),
+            line(None),
+            line(Some(MAX_CURB_STEP_M + 0.01)),
+        ]);
+        let steps: Vec<Option<f64>> = kept.iter().map(|(e, _)| e.curb_height_m).collect();
+        assert_eq!(steps, vec![Some(0.29), None]);
     }
 }

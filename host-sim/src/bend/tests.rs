@@ -470,11 +470,20 @@ fn a_parked_car_edge_is_removed_and_the_curb_kept() {
     };
     let sc = make_scene(&cfg);
     // The car's foot gives candidates, so without the vehicle filter it is tracked.
+    // Filter 4 (a step taller than any curb) is left out here, as it removes the foot too.
     let no_filter = BendParams {
         vehicle_share: 2.0,
         ..BendParams::default()
     };
-    let unfiltered = extract_edges(&sc.input(), &no_filter);
+    let input = sc.input();
+    let route = route::Route::new(input.trajectory);
+    let without_filter_4 = |p: &BendParams| -> Vec<EdgeLine> {
+        extract_edges_on_grid(&input, &point_grid(&input, p), &route, p)
+            .into_iter()
+            .map(|(e, _)| e)
+            .collect()
+    };
+    let unfiltered = without_filter_4(&no_filter);
     // On the car's foot: most of its points within 0.1 m of the foot line (a track may
     // start with a hop onto it).
     let on_car = |e: &EdgeLine| {
@@ -487,8 +496,11 @@ fn a_parked_car_edge_is_removed_and_the_curb_kept() {
     };
     // (It may come out in more than one piece: the precondition is only that it is there.)
     assert!(unfiltered.iter().any(on_car));
-    let edges = extract_edges(&sc.input(), &BendParams::default());
+    let edges = without_filter_4(&BendParams::default());
     assert!(!edges.iter().any(on_car), "{edges:#?}");
+    // Filter 4 alone removes it as well: the car's side is taller than any curb.
+    let tall = extract_edges(&input, &no_filter);
+    assert!(!tall.iter().any(on_car), "{tall:#?}");
     // The curb before and after the car is still there, on its toe.
     let left: Vec<_> = edges.iter().filter(|e| e.side == Side::Left).collect();
     assert_eq!(left.len(), 2, "{left:#?}");

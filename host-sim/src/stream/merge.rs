@@ -7,9 +7,11 @@
 //! piece that nothing continues is closed. Pieces carry the height step per vertex, so a
 //! joined edge's curb height is the median over all of it, as in a whole-file run. The
 //! short-edge filter of §2.7 runs again on joined edges: a stub left at a boundary is as
-//! short as it looks.
+//! short as it looks. Filter 4 (an edge whose median height step is taller than any curb,
+//! `bend::postfilter::tall_step`) runs here on every closed edge, on that whole median.
 
 use crate::bend::median;
+use crate::bend::postfilter::tall_step;
 use crate::model::EdgeLine;
 
 /// An edge piece from one section.
@@ -132,16 +134,17 @@ impl Merge {
 
     fn close(&self, p: Piece) -> Option<EdgeLine> {
         if !p.cut {
-            return Some(p.line);
+            return (!tall_step(&p.line)).then_some(p.line);
         }
         if p.line.length_m() < self.min_length_m {
             return None;
         }
         let mut st: Vec<f64> = p.steps.iter().flatten().copied().collect();
-        Some(EdgeLine {
+        let line = EdgeLine {
             curb_height_m: median(&mut st),
             ..p.line
-        })
+        };
+        (!tall_step(&line)).then_some(line)
     }
 }
 
