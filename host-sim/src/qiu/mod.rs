@@ -611,6 +611,21 @@ mod tests {
         assert_eq!(again, lines);
     }
 
+    /// The steps `measure_steps` gives a two-vertex chain along x (at 0.5 and 1.5 m, its
+    /// road side at negative y) on a grid of `pts`.
+    fn measure(pts: &[[f64; 3]], across: bool) -> Vec<f64> {
+        let grid = HeightGrid::new(pts, [0.0; 3]);
+        let mut c = Chain {
+            side: Side::Left,
+            pts: vec![[0.5, 0.0, 0.0], [1.5, 0.0, 0.0]],
+            s: vec![0.5, 1.5],
+            h: vec![f64::NAN; 2],
+            across,
+        };
+        grid.measure_steps(&mut c, [0.15, 0.6]);
+        c.h
+    }
+
     /// The height step of a line with ground on both sides is measured; a line along the
     /// border of the returns (nothing on its raised side but a few stray points) has no
     /// ground there. A sparse road side is measured along the trajectory (the vehicle's
@@ -628,18 +643,6 @@ mod tests {
                 }
             }
         }
-        let measure = |pts: &[[f64; 3]], across: bool| {
-            let grid = HeightGrid::new(pts, [0.0; 3]);
-            let mut c = Chain {
-                side: Side::Left,
-                pts: vec![[0.5, 0.0, 0.0], [1.5, 0.0, 0.0]],
-                s: vec![0.5, 1.5],
-                h: vec![f64::NAN; 2],
-                across,
-            };
-            grid.measure_steps(&mut c, [0.15, 0.6]);
-            c.h
-        };
         for across in [false, true] {
             for h in measure(&pts, across) {
                 assert!((h - 0.15).abs() < 1e-9, "{h}");
@@ -678,18 +681,6 @@ mod tests {
                 pts.push([ix as f64 * 0.25, y, 0.0]);
             }
         }
-        let measure = |pts: &[[f64; 3]], across: bool| {
-            let grid = HeightGrid::new(pts, [0.0; 3]);
-            let mut c = Chain {
-                side: Side::Left,
-                pts: vec![[0.5, 0.0, 0.0], [1.5, 0.0, 0.0]],
-                s: vec![0.5, 1.5],
-                h: vec![f64::NAN; 2],
-                across,
-            };
-            grid.measure_steps(&mut c, [0.15, 0.6]);
-            c.h
-        };
         let mut sparse = pts.clone();
         sparse.push([0.4, 0.3, 0.15]);
         sparse.push([1.6, 0.3, 0.15]);
