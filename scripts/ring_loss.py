@@ -22,7 +22,8 @@ An extracted sample farther than the buffer from every reference toe is false; i
 - on the toe's line, in a hole: within the buffer of the line through the nearest reference
   segment, between the first and last reference station of that side;
 - on the toe's line, beyond the ends: the same, outside that station range;
-- off the toe: farther across than the buffer (by the nearest reference's category).
+- off the toe: farther across than the buffer (by the nearest reference's category);
+  unattributed where no reference toe lies within 30 m.
 
 The matching is `curbtrace eval`'s (nearest line of any side); lengths agree with its FN and
 FP within a few centimetres. --runs lists the missed stretches one by one.
@@ -249,6 +250,10 @@ def main():
             if d <= a.buffer:
                 continue
             f = out["false"]
+            if j < 0:
+                # Farther than the eval's attribution reach: placed by the nearest toe all
+                # the same.
+                _, j, t = ref_seg.nearest(q, 30.0)
             if j < 0:
                 kind = "off_unattributed"
             else:

@@ -89,7 +89,9 @@ pub struct ArcParams {
     /// the curb changes along its length (a curb cut's transition from full to lowered
     /// height) such a crossing draws a step behind the toe, and the cross-section x′ = y
     /// reads it as a toe. 60°: crossings at 30° or more to a curb along the path; chosen
-    /// on simulated tuning drives (docs/results.md, *Spinning lidars*).
+    /// on simulated tuning drives (docs/results.md, *Spinning lidars*). One value for every
+    /// sensor: the error follows from the crossing's angle to the curb, which neither the
+    /// azimuth step nor the spacing of the rings changes.
     pub max_azimuth_deg: f32,
     /// Half-arcs whose pseudo-nadir lies farther ahead or behind than this are skipped,
     /// metres. 20 m: beyond it an HDL-64E's rings are more than 2 m apart on the road.
