@@ -13,6 +13,7 @@ use crate::replay::{Candidate, PointStatus};
 
 pub mod bridge;
 pub mod claims;
+pub mod climb;
 pub mod grid;
 pub mod params;
 pub mod postfilter;

@@ -9,6 +9,7 @@
 //! that meets another end to end is joined to it into one polyline.
 
 use super::claims::{Claims, Join};
+use super::climb::{climbed_toe, CLIMBED_SHARE};
 use super::grid::PointGrid;
 use super::params::{widened, BendParams};
 use super::profile::{cut_toe, profile_toe, usable, ProfileToe};
@@ -356,6 +357,10 @@ fn cut_on_line(
     (ahead > 0.25 * d_s).then_some((toe, a))
 }
 
+/// Farthest back from the toe a track brought down from the top edge drops the vertices
+/// it picked above that toe, metres: the few steps of a climb up the face.
+const CLIMB_DROP_M: f64 = 1.0;
+
 /// Largest angle between a track's search direction and the driving direction, degrees,
 /// for the track to take a wide profile's toe ([`wide_toe`]): a curb along the road turns
 /// from the driving direction by the road's curvature over the scanner's look-ahead (under
@@ -454,6 +459,9 @@ fn track_one_way(
 ) -> (Vec<(u32, [f64; 3])>, Option<Join>) {
     let s = start as usize;
     let mut cur = [input.x[s], input.y[s], input.z[s]];
+    // The side the curb rises on; a track brought down from the top edge takes the side
+    // the ground shows there.
+    let mut up = up;
     let Some(mut v) = unit3(dir0) else {
         return (Vec::new(), None);
     };
@@ -478,8 +486,9 @@ fn track_one_way(
     let mut weak_from: Option<usize> = None;
 
     for _ in 0..params.max_steps {
-        // Horizontal direction of the curb line this step's cut toe is found along, if
-        // any: it replaces the direction of the step to that toe (see [`line_ahead`]).
+        // Horizontal direction of the curb line this step's toe is found along, if any (a
+        // cut's toe, see [`line_ahead`], or a toe below the top edge): it replaces the
+        // direction of the step to that toe.
         let mut cut_dir: Option<[f64; 2]> = None;
         // The search position (Fig. 7): one search distance ahead along v.
         let pred = [
@@ -571,7 +580,35 @@ fn track_one_way(
             let ahead = |t: &ProfileToe| {
                 (t.xyz[0] - cur[0]) * along[0] + (t.xyz[1] - cur[1]) * along[1] > 0.25 * d_s
             };
-            match found.filter(ahead) {
+            // A track on the curb's top edge comes back down to the toe below it.
+            let found = match found.filter(ahead) {
+                Some(t) => Some(t),
+                None if params.profile_fallback && *next_virtual < u32::MAX => {
+                    let c = [pred[0], pred[1], cur[2]];
+                    climbed_toe(input, grid, c, along, params.profile_half_length_m, params)
+                        .filter(|(t, _)| ahead(t))
+                        .map(|(t, side)| {
+                            up = side;
+                            // The search keeps its heading: the step down to the toe runs
+                            // across the curb, not along it.
+                            cut_dir = Some(along);
+                            cut_run_m = 0.0;
+                            cut_from = None;
+                            // The vertices on the face and the top edge are no toes.
+                            while let Some(&(_, q)) = picked.last() {
+                                let near = (q[0] - t.xyz[0]).hypot(q[1] - t.xyz[1]) <= CLIMB_DROP_M;
+                                if near && q[2] > t.xyz[2] + CLIMBED_SHARE * t.step_m {
+                                    picked.pop();
+                                } else {
+                                    break;
+                                }
+                            }
+                            t
+                        })
+                }
+                None => None,
+            };
+            match found {
                 Some(toe) => {
                     weak_run_m = 0.0;
                     weak_from = None;
