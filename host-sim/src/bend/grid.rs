@@ -206,15 +206,6 @@ impl PointGrid {
         if !(px.is_finite() && py.is_finite() && r >= 0.0) {
             return;
         }
-        let test = |i: usize, f: &mut dyn FnMut(usize, f64, f64)| {
-            let dx = x[i] - px;
-            let dy = y[i] - py;
-            let a = dx * along[0] + dy * along[1];
-            let c = dx * n[0] + dy * n[1];
-            if a.abs() <= half_a && c.abs() <= half_c {
-                f(i, c, a);
-            }
-        };
         // The corners: the offsets whose (a, c) are (±half_a, ±half_c).
         let det = along[0] * n[1] - along[1] * n[0];
         let corner = |a: f64, c: f64| {
@@ -223,7 +214,7 @@ impl PointGrid {
                 py + (along[0] * c - n[0] * a) / det,
             ]
         };
-        let rect = Rect {
+        let mut rect = Rect {
             corners: [
                 corner(half_a, half_c),
                 corner(half_a, -half_c),
@@ -232,9 +223,13 @@ impl PointGrid {
             ],
         };
         if !rect.corners.iter().flatten().all(|v| v.is_finite()) {
-            // No rectangle to scan (a degenerate direction): the whole disc.
-            self.for_each_within(x, y, px, py, r, |i| test(i, &mut f));
-            return;
+            // No rectangle to scan (a degenerate direction): the disc's square.
+            rect.corners = [
+                [px + r, py + r],
+                [px + r, py - r],
+                [px - r, py - r],
+                [px - r, py + r],
+            ];
         }
         for s in &self.slabs {
             if s.order.is_empty()
@@ -540,14 +535,16 @@ impl CellOf {
         }
     }
 
-    /// `d ≥ 0` (inside the box), so truncation is the floor.
+    /// `d ≥ 0` (inside the box), so truncation is the floor. Through `i64`, whose
+    /// conversions to and from `f64` are single instructions (those of `u64` are not on
+    /// x86-64); a quotient this large would be no grid's cell anyway.
     #[inline]
     fn axis(&self, d: f64, n: usize) -> usize {
         let q = d * self.inv;
-        let k = q as usize;
+        let k = q as i64;
         let frac = q - k as f64;
         let k = if frac > 1e-6 && frac < 1.0 - 1e-6 {
-            k
+            k as usize
         } else {
             self.divided(d)
         };
