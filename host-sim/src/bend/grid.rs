@@ -5,17 +5,44 @@
 //! most half as many cells as points — about 6 bytes per point in all, and a bit per point
 //! and 4 bytes per indexed point (its cell) while it is built. A query visits only the
 //! cells the disc touches, never the whole cloud.
+//!
+//! A stream's windows overlap: each holds the margin of road the window before it held
+//! too. The grid is therefore made of *slabs*, each indexing a run of consecutive points
+//! in a box of its own; [`slide`](PointGrid::slide) keeps the slabs a new window still
+//! holds, drops the others and indexes only the points not yet in a slab, so each point
+//! is bucketed once however many windows hold it.
 
-/// Point indices bucketed by a square XY cell over the points' bounding box.
+/// Point indices bucketed by square XY cells, slab by slab.
 pub struct PointGrid {
+    /// Stream index of index 0 of the slices the grid was last given.
+    origin: u64,
+    /// Slabs in order of their first point; together they cover the slices given.
+    slabs: Vec<Slab>,
+    /// Slabs no longer held, kept for their arrays.
+    spare: Vec<Slab>,
+}
+
+/// One slab: the points of a run of consecutive stream indices, bucketed by a square cell
+/// over their bounding box.
+#[derive(Default)]
+struct Slab {
+    /// Stream index of the run's first point; `order` counts from it.
+    start: u64,
+    /// Points in the run, indexed or not.
+    span: usize,
+    /// Cell size asked for (the one in use may be larger).
+    asked_m: f64,
     cell_m: f64,
     x0: f64,
     y0: f64,
+    /// Far corner of the indexed points' box, for a quick miss.
+    x1: f64,
+    y1: f64,
     nx: usize,
     ny: usize,
     /// `starts[c]..starts[c + 1]` is cell `c`'s range in `order` (`c = cy·nx + cx`).
     starts: Vec<u32>,
-    /// Point indices, sorted by cell then index.
+    /// Point indices from `start`, sorted by cell then index.
     order: Vec<u32>,
 }
 
@@ -27,23 +54,236 @@ impl PointGrid {
     /// for the two passes of the counting sort.
     pub fn build(x: &[f64], y: &[f64], cell_m: f64, keep: impl Fn(usize) -> bool) -> Self {
         let mut g = Self {
-            cell_m: 1.0,
-            x0: 0.0,
-            y0: 0.0,
-            nx: 0,
-            ny: 0,
-            starts: Vec::new(),
-            order: Vec::new(),
+            origin: 0,
+            slabs: Vec::new(),
+            spare: Vec::new(),
         };
         g.rebuild(x, y, cell_m, keep);
         g
     }
 
     /// [`build`](Self::build) in place: the same index, in the cell and order arrays this
-    /// grid already holds. A stream builds a grid for every section; reusing the arrays
-    /// spares the kernel mapping and zeroing fresh pages for them each time.
+    /// grid already holds (one slab over every point).
     pub fn rebuild(&mut self, x: &[f64], y: &[f64], cell_m: f64, keep: impl Fn(usize) -> bool) {
         let n = x.len().min(y.len()).min(u32::MAX as usize - 1);
+        self.origin = 0;
+        self.retire(|_| true);
+        self.add_slab(&x[..n], &y[..n], 0, n, cell_m, &keep);
+    }
+
+    /// The index of the points `i` with `keep(i)` true (and finite coordinates) of slices
+    /// `x`, `y` whose index 0 is point `origin` of a stream: the slabs that lie within the
+    /// slices are kept, the others dropped, and the points no slab holds are indexed in new
+    /// slabs, cut at `cut` (an index into the slices) when it falls among them. A caller
+    /// that gives the index where its next slices will begin as `cut` has every point
+    /// bucketed once. `keep` must give a point the same answer on every call.
+    ///
+    /// Queries visit the slabs in turn, so the order of their points depends on where the
+    /// slabs were cut, not only on the points.
+    pub fn slide(
+        &mut self,
+        x: &[f64],
+        y: &[f64],
+        origin: u64,
+        cut: Option<usize>,
+        cell_m: f64,
+        keep: impl Fn(usize) -> bool,
+    ) {
+        let n = x.len().min(y.len()).min(u32::MAX as usize - 1);
+        let (x, y) = (&x[..n], &y[..n]);
+        let end = origin + n as u64;
+        self.origin = origin;
+        self.retire(|s| s.start < origin || s.start + s.span as u64 > end || s.asked_m != cell_m);
+        let held: Vec<(usize, usize)> = self
+            .slabs
+            .iter()
+            .map(|s| {
+                let a = (s.start - origin) as usize;
+                (a, a + s.span)
+            })
+            .collect();
+        let mut from = 0;
+        for (a, b) in held.into_iter().chain([(n, n)]) {
+            if a > from {
+                match cut {
+                    Some(c) if c > from && c < a => {
+                        self.add_slab(x, y, from, c, cell_m, &keep);
+                        self.add_slab(x, y, c, a, cell_m, &keep);
+                    }
+                    _ => self.add_slab(x, y, from, a, cell_m, &keep),
+                }
+            }
+            from = from.max(b);
+        }
+        self.slabs.sort_unstable_by_key(|s| s.start);
+    }
+
+    /// Moves the slabs for which `drop` holds to the spares.
+    fn retire(&mut self, drop: impl Fn(&Slab) -> bool) {
+        let mut k = 0;
+        while k < self.slabs.len() {
+            if drop(&self.slabs[k]) {
+                let s = self.slabs.swap_remove(k);
+                self.spare.push(s);
+            } else {
+                k += 1;
+            }
+        }
+        self.slabs.sort_unstable_by_key(|s| s.start);
+    }
+
+    /// Indexes the points `lo..hi` of the slices in a new slab, in the arrays of the spare
+    /// that holds the most.
+    fn add_slab(
+        &mut self,
+        x: &[f64],
+        y: &[f64],
+        lo: usize,
+        hi: usize,
+        cell_m: f64,
+        keep: &impl Fn(usize) -> bool,
+    ) {
+        let best = (0..self.spare.len()).max_by_key(|&k| self.spare[k].order.capacity());
+        let mut s = best.map_or_else(Slab::default, |k| self.spare.swap_remove(k));
+        s.start = self.origin + lo as u64;
+        s.span = hi - lo;
+        s.asked_m = cell_m;
+        s.index(&x[lo..hi], &y[lo..hi], cell_m, |i| keep(lo + i));
+        self.slabs.push(s);
+        // A spare beyond the two a window's slide reuses only holds memory.
+        self.spare.truncate(2);
+    }
+
+    /// Calls `f(i)` for every indexed point within `r` (horizontal) of `(px, py)`, in a
+    /// fixed order (slab by slab, cells row by row, indices ascending within a cell).
+    pub fn for_each_within(
+        &self,
+        x: &[f64],
+        y: &[f64],
+        px: f64,
+        py: f64,
+        r: f64,
+        mut f: impl FnMut(usize),
+    ) {
+        if !(px.is_finite() && py.is_finite() && r >= 0.0) {
+            return;
+        }
+        for s in &self.slabs {
+            if s.order.is_empty()
+                || px + r < s.x0
+                || px - r > s.x1
+                || py + r < s.y0
+                || py - r > s.y1
+            {
+                continue;
+            }
+            let off = (s.start - self.origin) as usize;
+            s.for_each_within(&x[off..], &y[off..], px, py, r, |i| f(off + i));
+        }
+    }
+
+    /// Calls `f(i, c, a)` for every indexed point within `r` (horizontal) of `centre`
+    /// that lies on the rectangle around it of half-length `half_a` along the unit vector
+    /// `along` and half-width `half_c` along the unit vector `n`, with `a` and `c` its
+    /// offsets along `along` and `n` (`a = dx·along₀ + dy·along₁`, `c = dx·n₀ + dy·n₁`).
+    /// The points are those of [`for_each_within`](Self::for_each_within) with
+    /// `|a| ≤ half_a` and `|c| ≤ half_c`, in the same order; only the cells the rectangle
+    /// touches are visited, not all those of the disc around it.
+    #[allow(clippy::too_many_arguments)]
+    pub fn for_each_in_rect(
+        &self,
+        x: &[f64],
+        y: &[f64],
+        centre: [f64; 2],
+        along: [f64; 2],
+        n: [f64; 2],
+        half_a: f64,
+        half_c: f64,
+        r: f64,
+        mut f: impl FnMut(usize, f64, f64),
+    ) {
+        let [px, py] = centre;
+        if !(px.is_finite() && py.is_finite() && r >= 0.0) {
+            return;
+        }
+        // The corners: the offsets whose (a, c) are (±half_a, ±half_c).
+        let det = along[0] * n[1] - along[1] * n[0];
+        let corner = |a: f64, c: f64| {
+            [
+                px + (n[1] * a - along[1] * c) / det,
+                py + (along[0] * c - n[0] * a) / det,
+            ]
+        };
+        let mut rect = Rect {
+            corners: [
+                corner(half_a, half_c),
+                corner(half_a, -half_c),
+                corner(-half_a, -half_c),
+                corner(-half_a, half_c),
+            ],
+        };
+        if !rect.corners.iter().flatten().all(|v| v.is_finite()) {
+            // No rectangle to scan (a degenerate direction): the disc's square.
+            rect.corners = [
+                [px + r, py + r],
+                [px + r, py - r],
+                [px - r, py - r],
+                [px - r, py + r],
+            ];
+        }
+        for s in &self.slabs {
+            if s.order.is_empty()
+                || px + r < s.x0
+                || px - r > s.x1
+                || py + r < s.y0
+                || py - r > s.y1
+            {
+                continue;
+            }
+            let off = (s.start - self.origin) as usize;
+            let (x, y) = (&x[off..], &y[off..]);
+            let r2 = r * r;
+            s.for_each_in_rows(px, py, r, &rect, |i| {
+                let dx = x[i] - px;
+                let dy = y[i] - py;
+                if dx * dx + dy * dy > r2 {
+                    return;
+                }
+                let a = dx * along[0] + dy * along[1];
+                let c = dx * n[0] + dy * n[1];
+                if a.abs() <= half_a && c.abs() <= half_c {
+                    f(off + i, c, a);
+                }
+            });
+        }
+    }
+
+    /// Number of indexed points.
+    pub fn len(&self) -> usize {
+        self.slabs.iter().map(|s| s.order.len()).sum()
+    }
+
+    /// Whether no point is indexed.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Cell size in use, metres (at least the one asked for; the first slab's).
+    pub fn cell_m(&self) -> f64 {
+        self.slabs.first().map_or(1.0, |s| s.cell_m)
+    }
+
+    /// Number of slabs (for tests).
+    #[cfg(test)]
+    fn slab_count(&self) -> usize {
+        self.slabs.len()
+    }
+}
+
+impl Slab {
+    /// Indexes the points `i` of `x`, `y` with `keep(i)` true and finite coordinates.
+    fn index(&mut self, x: &[f64], y: &[f64], cell_m: f64, keep: impl Fn(usize) -> bool) {
+        let n = x.len().min(y.len());
         let (x, y) = (&x[..n], &y[..n]);
         let mut kept = vec![0u64; n.div_ceil(64)];
         let (mut x0, mut y0, mut x1, mut y1) = (
@@ -72,7 +312,7 @@ impl PointGrid {
         self.order.clear();
         if count == 0 {
             self.cell_m = cell;
-            (self.x0, self.y0, self.nx, self.ny) = (0.0, 0.0, 0, 0);
+            (self.x0, self.y0, self.x1, self.y1, self.nx, self.ny) = (0.0, 0.0, 0.0, 0.0, 0, 0);
             self.starts.push(0);
             return;
         }
@@ -87,6 +327,7 @@ impl PointGrid {
         let (a, b) = dims(cell);
         let (nx, ny) = (a as usize, b as usize);
         (self.cell_m, self.x0, self.y0, self.nx, self.ny) = (cell, x0, y0, nx, ny);
+        (self.x1, self.y1) = (x1, y1);
         self.starts.resize(nx * ny + 1, 0);
         // Each kept point's cell, found once for the count and kept for the scatter (4
         // bytes a kept point while the grid is built).
@@ -116,9 +357,52 @@ impl PointGrid {
         starts[0] = 0;
     }
 
-    /// Calls `f(i)` for every indexed point within `r` (horizontal) of `(px, py)`, in a
-    /// fixed order (cells row by row, indices ascending within a cell).
-    pub fn for_each_within(
+    /// Calls `f(i)` for the points of the cells that the disc of `r` around `(px, py)`
+    /// and `rect` both touch, row by row (each row's cells from the rectangle's extent in
+    /// that row's band, a micrometre wider either way than the float cell bounds need).
+    fn for_each_in_rows(&self, px: f64, py: f64, r: f64, rect: &Rect, mut f: impl FnMut(usize)) {
+        const SLACK_M: f64 = 1e-6;
+        let span = |lo: f64, hi: f64, n: usize| -> Option<(usize, usize)> {
+            let a = floor(lo / self.cell_m);
+            let b = floor(hi / self.cell_m);
+            if b < 0.0 || a >= n as f64 {
+                return None;
+            }
+            Some((a.max(0.0) as usize, (b as usize).min(n - 1)))
+        };
+        let Some((ax, bx)) = span(px - r - self.x0, px + r - self.x0, self.nx) else {
+            return;
+        };
+        let Some((ay, by)) = span(py - r - self.y0, py + r - self.y0, self.ny) else {
+            return;
+        };
+        for cy in ay..=by {
+            let band0 = self.y0 + cy as f64 * self.cell_m - SLACK_M;
+            let band1 = self.y0 + (cy + 1) as f64 * self.cell_m + SLACK_M;
+            let Some((x_lo, x_hi)) = rect.x_range(band0, band1) else {
+                continue;
+            };
+            let Some((rx, sx)) = span(x_lo - SLACK_M - self.x0, x_hi + SLACK_M - self.x0, self.nx)
+            else {
+                continue;
+            };
+            let (lo_c, hi_c) = (rx.max(ax), sx.min(bx));
+            if lo_c > hi_c {
+                continue;
+            }
+            let row = cy * self.nx;
+            let (lo, hi) = (
+                self.starts[row + lo_c] as usize,
+                self.starts[row + hi_c + 1] as usize,
+            );
+            for &i in &self.order[lo..hi] {
+                f(i as usize);
+            }
+        }
+    }
+
+    /// [`PointGrid::for_each_within`] on this slab, `x`, `y` starting at its first point.
+    fn for_each_within(
         &self,
         x: &[f64],
         y: &[f64],
@@ -127,9 +411,6 @@ impl PointGrid {
         r: f64,
         mut f: impl FnMut(usize),
     ) {
-        if self.order.is_empty() || !(px.is_finite() && py.is_finite() && r >= 0.0) {
-            return;
-        }
         let span = |lo: f64, hi: f64, n: usize| -> Option<(usize, usize)> {
             let a = floor(lo / self.cell_m);
             let b = floor(hi / self.cell_m);
@@ -161,20 +442,43 @@ impl PointGrid {
             }
         }
     }
+}
 
-    /// Number of indexed points.
-    pub fn len(&self) -> usize {
-        self.order.len()
-    }
+/// A convex quadrilateral (corners in order around it) for row-by-row cell ranges.
+struct Rect {
+    corners: [[f64; 2]; 4],
+}
 
-    /// Whether no point is indexed.
-    pub fn is_empty(&self) -> bool {
-        self.order.is_empty()
-    }
-
-    /// Cell size in use, metres (at least the one asked for).
-    pub fn cell_m(&self) -> f64 {
-        self.cell_m
+impl Rect {
+    /// The extent in x of the part of the rectangle with `y` in `[y0, y1]`; `None` when
+    /// that part is empty. Exact up to rounding: the part's corners are the rectangle's
+    /// corners in the band and the points where its edges cross the band's lines.
+    fn x_range(&self, y0: f64, y1: f64) -> Option<(f64, f64)> {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for k in 0..4 {
+            let (p, q) = (self.corners[k], self.corners[(k + 1) % 4]);
+            let (p, q) = if p[1] <= q[1] { (p, q) } else { (q, p) };
+            if q[1] < y0 || p[1] > y1 {
+                continue;
+            }
+            let dy = q[1] - p[1];
+            let at = |v: f64| {
+                if dy > 0.0 {
+                    p[0] + (q[0] - p[0]) * ((v - p[1]) / dy).clamp(0.0, 1.0)
+                } else {
+                    p[0]
+                }
+            };
+            for v in [at(p[1].max(y0)), at(q[1].min(y1))] {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+            if dy <= 0.0 {
+                lo = lo.min(q[0]);
+                hi = hi.max(q[0]);
+            }
+        }
+        (lo <= hi).then_some((lo, hi))
     }
 }
 
@@ -220,7 +524,7 @@ struct CellOf {
 }
 
 impl CellOf {
-    fn new(g: &PointGrid) -> Self {
+    fn new(g: &Slab) -> Self {
         Self {
             x0: g.x0,
             y0: g.y0,
@@ -231,14 +535,16 @@ impl CellOf {
         }
     }
 
-    /// `d ≥ 0` (inside the box), so truncation is the floor.
+    /// `d ≥ 0` (inside the box), so truncation is the floor. Through `i64`, whose
+    /// conversions to and from `f64` are single instructions (those of `u64` are not on
+    /// x86-64); a quotient this large would be no grid's cell anyway.
     #[inline]
     fn axis(&self, d: f64, n: usize) -> usize {
         let q = d * self.inv;
-        let k = q as usize;
+        let k = q as i64;
         let frac = q - k as f64;
         let k = if frac > 1e-6 && frac < 1.0 - 1e-6 {
-            k
+            k as usize
         } else {
             self.divided(d)
         };
@@ -393,6 +699,88 @@ mod tests {
                 assert_eq!(a, b);
                 assert!(a.iter().all(|&i| keep(i)));
                 assert!(n < 5_000 || !a.is_empty());
+            }
+        }
+    }
+
+    #[test]
+    fn a_slid_grid_answers_as_a_grid_built_afresh() {
+        // A stream of points along x (10 per metre, two lanes), seen through overlapping
+        // windows of 80 points that start 60 points apart, every third point left out.
+        let n = 400usize;
+        let x: Vec<f64> = (0..n).map(|k| 700_000.0 + k as f64 * 0.1).collect();
+        let y: Vec<f64> = (0..n)
+            .map(|k| 3_000_000.0 + (k % 2) as f64 * 0.07)
+            .collect();
+        let keep = |g: usize| g % 3 != 1;
+        let mut g = PointGrid::build(&[], &[], 0.1, |_| false);
+        let mut lo = 0;
+        while lo < n {
+            let hi = (lo + 80).min(n);
+            let next = lo + 60;
+            g.slide(
+                &x[lo..hi],
+                &y[lo..hi],
+                lo as u64,
+                Some(next - lo),
+                0.1,
+                |i| keep(lo + i),
+            );
+            // The shared 20 points stay in the slab the window before indexed.
+            assert!(g.slab_count() <= 3, "{}", g.slab_count());
+            let fresh = PointGrid::build(&x[lo..hi], &y[lo..hi], 0.1, |i| keep(lo + i));
+            assert_eq!(g.len(), fresh.len());
+            for q in (lo..hi).step_by(7) {
+                let (mut a, mut b) = (Vec::new(), Vec::new());
+                g.for_each_within(&x[lo..hi], &y[lo..hi], x[q], y[q], 0.35, |i| a.push(i));
+                fresh.for_each_within(&x[lo..hi], &y[lo..hi], x[q], y[q], 0.35, |i| b.push(i));
+                a.sort_unstable();
+                b.sort_unstable();
+                assert_eq!(a, b);
+                assert!(!a.is_empty());
+            }
+            lo = next;
+        }
+        // A rebuild after a slide is one slab again.
+        g.rebuild(&x, &y, 0.1, |_| true);
+        assert_eq!((g.slab_count(), g.len()), (1, n));
+    }
+
+    #[test]
+    fn a_rectangle_query_is_the_disc_query_cut_to_the_rectangle() {
+        // A scatter around a point far from the origin; rectangles turned by many angles,
+        // across cell sizes, in the disc query's order.
+        let (x0, y0) = (455_000.0, 3_951_000.0);
+        let mut x = Vec::new();
+        let mut y = Vec::new();
+        for k in 0..6_000u32 {
+            x.push(x0 + f64::from(k.wrapping_mul(2_654_435_761) % 3_001) * 1e-3);
+            y.push(y0 + f64::from(k.wrapping_mul(40_503) % 2_003) * 1e-3);
+        }
+        for cell in [0.1, 0.15, 0.37] {
+            let g = PointGrid::build(&x, &y, cell, |i| i % 11 != 4);
+            for q in 0..40u32 {
+                let th = f64::from(q) * 0.157;
+                let along = [th.cos(), th.sin()];
+                let n = [-along[1], along[0]];
+                let centre = [x0 + 1.5 + f64::from(q % 5) * 0.1, y0 + 1.0];
+                let (ha, hc) = (0.3, 0.45);
+                let r = f64::hypot(ha, hc);
+                let mut want = Vec::new();
+                g.for_each_within(&x, &y, centre[0], centre[1], r, |i| {
+                    let d = [x[i] - centre[0], y[i] - centre[1]];
+                    let a = d[0] * along[0] + d[1] * along[1];
+                    let c = d[0] * n[0] + d[1] * n[1];
+                    if a.abs() <= ha && c.abs() <= hc {
+                        want.push((i, c, a));
+                    }
+                });
+                let mut got = Vec::new();
+                g.for_each_in_rect(&x, &y, centre, along, n, ha, hc, r, |i, c, a| {
+                    got.push((i, c, a))
+                });
+                assert_eq!(got, want, "cell {cell}, angle {th}");
+                assert!(want.len() > 50, "{}", want.len());
             }
         }
     }

@@ -133,6 +133,24 @@ pub fn point_grid_into(grid: &mut grid::PointGrid, input: &BendInput, params: &B
     grid.rebuild(input.x, input.y, cell_m, |i| input.status[i].is_some());
 }
 
+/// [`point_grid_into`] for a window of a stream whose index 0 is the stream's point
+/// `origin`: the slabs of `grid` that the window still holds are kept and only its new
+/// points indexed, in slabs cut at `cut`, where the next window will begin
+/// ([`grid::PointGrid::slide`]).
+pub fn point_grid_slide(
+    grid: &mut grid::PointGrid,
+    input: &BendInput,
+    origin: u64,
+    cut: Option<usize>,
+    params: &BendParams,
+) {
+    let input = input.truncated();
+    let cell_m = params.search_radius_m.clamp(0.05, 1.0);
+    grid.slide(input.x, input.y, origin, cut, cell_m, |i| {
+        input.status[i].is_some()
+    });
+}
+
 /// [`extract_edges_on_route`] on `grid`, the [`point_grid`] of `input`.
 pub fn extract_edges_on_grid(
     input: &BendInput,

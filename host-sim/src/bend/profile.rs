@@ -174,22 +174,20 @@ pub(super) fn for_each_on_profile(
 ) {
     let half_w = params.profile_half_width_m;
     let n = [-along[1] * up, along[0] * up];
-    grid.for_each_within(
+    grid.for_each_in_rect(
         input.x,
         input.y,
-        centre[0],
-        centre[1],
+        [centre[0], centre[1]],
+        along,
+        n,
+        half_l,
+        half_w,
         half_w.hypot(half_l),
-        |i| {
+        |i, c, a| {
             if !usable(input, i) || (input.z[i] - centre[2]).abs() > params.search_half_height_m {
                 return;
             }
-            let d = [input.x[i] - centre[0], input.y[i] - centre[1]];
-            let a = d[0] * along[0] + d[1] * along[1];
-            let c = d[0] * n[0] + d[1] * n[1];
-            if a.abs() <= half_l && c.abs() <= half_w {
-                f(i, c, a);
-            }
+            f(i, c, a);
         },
     );
 }

@@ -181,12 +181,22 @@ pub struct KernelResults {
 
 /// The chunk ranges (cut at line starts, independent of the thread count).
 pub fn chunks(cols: &PointColumns, rule: &LineRule, chunk_points: usize) -> Vec<Range<usize>> {
-    let n = cols.len();
-    if !rule.flags_lines() || n == 0 {
-        return std::iter::once(0..n).collect();
+    chunks_in(cols, 0..cols.len(), rule, chunk_points)
+}
+
+/// [`chunks`] of the points `range` of `cols` (`range.start` taken as a line start).
+fn chunks_in(
+    cols: &PointColumns,
+    range: Range<usize>,
+    rule: &LineRule,
+    chunk_points: usize,
+) -> Vec<Range<usize>> {
+    let n = range.end.min(cols.len());
+    if !rule.flags_lines() || range.start >= n {
+        return std::iter::once(range.start..n.max(range.start)).collect();
     }
     let mut out = Vec::new();
-    let mut a = 0;
+    let mut a = range.start;
     while a < n {
         let mut b = (a + chunk_points.max(1)).min(n);
         while b < n && !rule.is_start(b, &cols.scan_angle_deg, &cols.t) {
@@ -455,9 +465,25 @@ pub fn run_kernel_with_rule(
     rule: &LineRule,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<KernelResults, ReplayError> {
+    run_kernel_on(cols, 0..cols.len(), traj, words, params, rule, progress)
+}
+
+/// [`run_kernel_with_rule`] on the points `range` of `cols` (`range.start` a line start):
+/// the results are indexed from `range.start`, candidates included. A stream runs the
+/// reader's columns in place this way instead of copying the points it runs.
+pub fn run_kernel_on(
+    cols: &PointColumns,
+    range: Range<usize>,
+    traj: &Trajectory,
+    words: &[u32; CONFIG_WORDS],
+    params: &ReplayParams,
+    rule: &LineRule,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<KernelResults, ReplayError> {
     let rule = *rule;
-    let n = cols.len();
-    let ranges = chunks(cols, &rule, params.chunk_points);
+    let ranges = chunks_in(cols, range.clone(), &rule, params.chunk_points);
+    let n = ranges.iter().map(|r| r.len()).sum();
+    let first = u32::try_from(range.start).unwrap_or(u32::MAX);
     let mut rho = vec![0f32; n];
     let mut status = vec![None; n];
     let mut scanline = vec![0u32; n];
@@ -509,6 +535,7 @@ pub fn run_kernel_with_rule(
         counters.add(&o.counters);
         candidates.extend(o.candidates.into_iter().map(|c| Candidate {
             scanline: c.scanline + base,
+            point: c.point - first,
             ..c
         }));
         base = base.saturating_add(o.lines);

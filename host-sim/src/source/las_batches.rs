@@ -144,8 +144,13 @@ impl LasBatches {
         };
         let file = File::open(path).map_err(io)?;
         let file_bytes = file.metadata().map_err(io)?.len();
+        // An uncompressed file is read a slab of records at a time (most of a megabyte);
+        // a read at least as large as the buffer bypasses it, so the records go from the
+        // file straight into the decoder's bytes instead of through a copy in the buffer.
+        // LAZ reads its chunks in small pieces and keeps the large buffer.
+        let buffer = if head.compressed { 1 << 20 } else { 1 << 14 };
         let reader = Reader::with_options(
-            BufReader::with_capacity(1 << 20, file),
+            BufReader::with_capacity(buffer, file),
             ReaderOptions::default(),
         )
         .map_err(|e| LasError::Las {

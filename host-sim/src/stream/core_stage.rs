@@ -42,6 +42,11 @@ pub enum CoreError {
 pub struct CoreBatch {
     /// Stream index of the first point.
     pub base: u64,
+    /// Points at the front of `x`, `y`, `z` and `t` that are not this batch's (they went
+    /// in the batch before it): a reader's batch is handed on whole rather than copied
+    /// without them. The batch's points are `x[skip..]`; `rho_deg`, `status` and
+    /// `scanline` hold only them.
+    pub skip: usize,
     /// World X.
     pub x: Vec<f64>,
     /// World Y.
@@ -138,13 +143,64 @@ impl<'a> CoreStage<'a> {
     }
 
     /// Takes a batch; returns the core's output for the whole lines it completes.
-    pub fn push(&mut self, b: PointBatch) -> Result<Option<CoreBatch>, CoreError> {
+    ///
+    /// The line carried from the batch before is completed with the points of `b` up to
+    /// its first line start and run on its own; the whole lines of `b` after it are run in
+    /// `b`'s own columns, so only the carried line and the new partial line are copied.
+    pub fn push(&mut self, b: PointBatch) -> Result<Vec<CoreBatch>, CoreError> {
         let kept = self.intake.admit(&b);
-        if self.carry.is_empty() && kept == (0..b.len()) {
-            self.carry = b;
-        } else {
-            self.carry.extend_from(&b, kept);
+        let first = match self.rule {
+            Some(rule) if rule.flags_lines() && !self.carry.is_empty() && !kept.is_empty() => {
+                self.first_start(&rule, &b, kept.clone())
+            }
+            _ => None,
+        };
+        let Some(f) = first else {
+            if self.carry.is_empty() && kept == (0..b.len()) {
+                self.carry = b;
+            } else {
+                self.carry.extend_from(&b, kept);
+            }
+            return Ok(self.run_carry()?.into_iter().collect());
+        };
+        // The carried line ends where `b`'s first line starts.
+        self.carry.extend_from(&b, kept.start..f);
+        let head = self.run(self.carry.len())?;
+        self.carry = b;
+        self.carry.keep_range(0..kept.end);
+        let mut out = vec![head];
+        let rule = self.rule.unwrap_or(LineRule::None);
+        let c = &self.carry;
+        let last = (f + 1..c.len())
+            .rev()
+            .find(|&i| rule.is_start(i, &c.scan_angle_deg, &c.t));
+        match last {
+            Some(cut) => out.push(self.run_from(f, cut)?),
+            None => self.carry.drain_front(f),
         }
+        Ok(out)
+    }
+
+    /// The first point of `b`'s `kept` that starts a line, the first one judged against the
+    /// carried line's last point.
+    fn first_start(
+        &self,
+        rule: &LineRule,
+        b: &PointBatch,
+        kept: std::ops::Range<usize>,
+    ) -> Option<usize> {
+        let c = &self.carry;
+        let last = c.len().checked_sub(1)?;
+        let a = [c.scan_angle_deg[last], b.scan_angle_deg[kept.start]];
+        let t = [c.t[last], b.t[kept.start]];
+        if rule.is_start(1, &a, &t) {
+            return Some(kept.start);
+        }
+        (kept.start + 1..kept.end).find(|&i| rule.is_start(i, &b.scan_angle_deg, &b.t))
+    }
+
+    /// Chooses the line rule on the first points and runs the whole lines carried.
+    fn run_carry(&mut self) -> Result<Option<CoreBatch>, CoreError> {
         if self.carry.is_empty() {
             return Ok(None);
         }
@@ -183,9 +239,16 @@ impl<'a> CoreStage<'a> {
 
     /// Runs the first `n` carried points through the core.
     fn run(&mut self, n: usize) -> Result<CoreBatch, CoreError> {
+        self.run_from(0, n)
+    }
+
+    /// Runs the carried points `from..n` (`from` a line start) through the core; the
+    /// points after them stay carried, those before them go with the batch as its `skip`.
+    fn run_from(&mut self, from: usize, n: usize) -> Result<CoreBatch, CoreError> {
         let rest = if n < self.carry.len() {
-            let mut r =
-                PointBatch::with_capacity(self.carry.len() - n + super::STREAM_BATCH_POINTS);
+            // Room for the line's rest from the next batch; a batch without a line start
+            // is appended whole and grows it.
+            let mut r = PointBatch::with_capacity(2 * (self.carry.len() - n));
             r.extend_from(&self.carry, n..self.carry.len());
             r
         } else {
@@ -194,8 +257,16 @@ impl<'a> CoreStage<'a> {
         let mut cols = std::mem::replace(&mut self.carry, rest);
         cols.keep_range(0..n);
         let rule = self.rule.unwrap_or(LineRule::None);
-        let k =
-            run::run_kernel_with_rule(&cols, self.traj, &self.words, &self.params, &rule, &|_| {})?;
+        let k = run::run_kernel_on(
+            &cols,
+            from..n,
+            self.traj,
+            &self.words,
+            &self.params,
+            &rule,
+            &|_| {},
+        )?;
+        let n = n - from;
         let base = self.next_base;
         let lines = self.lines;
         self.next_base += n as u64;
@@ -208,6 +279,7 @@ impl<'a> CoreStage<'a> {
         }
         Ok(CoreBatch {
             base,
+            skip: from,
             x: cols.x,
             y: cols.y,
             z: cols.z,

@@ -478,10 +478,10 @@ impl<'a> Stage<'a> {
     pub(super) fn push(
         &mut self,
         b: PointBatch,
-    ) -> Result<Option<core_stage::CoreBatch>, core_stage::CoreError> {
+    ) -> Result<Vec<core_stage::CoreBatch>, core_stage::CoreError> {
         match self {
             Stage::Lines(s) => s.push(b),
-            Stage::Rings(s) => s.push(b),
+            Stage::Rings(s) => s.push(b).map(|o| o.into_iter().collect()),
         }
     }
 
@@ -643,12 +643,13 @@ fn run_pass(
                     let out = stage.push(b);
                     busy += t0.elapsed().as_secs_f64();
                     match out {
-                        Ok(Some(c)) => {
-                            if tx_c.send(Ok(c)).is_err() {
-                                return None;
+                        Ok(cs) => {
+                            for c in cs {
+                                if tx_c.send(Ok(c)).is_err() {
+                                    return None;
+                                }
                             }
                         }
-                        Ok(None) => {}
                         Err(e) => {
                             let _ = tx_c.send(Err(PassError::Core(e)));
                             return None;

@@ -589,6 +589,7 @@ impl<'a> RingStage<'a> {
         self.points += cut as u64;
         self.counters.add(&counters);
         Ok(CoreBatch {
+            skip: 0,
             base,
             x: cols.x,
             y: cols.y,

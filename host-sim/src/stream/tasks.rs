@@ -165,7 +165,7 @@ pub fn run(
         // The source's batches go to the core as they are (only cut to the task's times):
         // the core's work is cut at batch boundaries, so these are `extract`'s batches.
         if lo == 0 && hi == b.len() {
-            if let Some(c) = core.push(b).map_err(|e| stream_err(e.to_string()))? {
+            for c in core.push(b).map_err(|e| stream_err(e.to_string()))? {
                 whole.extend(win.push(c));
             }
             continue;
@@ -174,7 +174,7 @@ pub fn run(
         part.extend_from(&b, lo..hi);
         let past = hi < b.len();
         if !part.is_empty() {
-            if let Some(c) = core.push(part).map_err(|e| stream_err(e.to_string()))? {
+            for c in core.push(part).map_err(|e| stream_err(e.to_string()))? {
                 whole.extend(win.push(c));
             }
         }

@@ -83,10 +83,11 @@ impl Columns {
         if self.t.is_empty() {
             self.base = b.base;
         }
+        let s = b.skip.min(b.t.len());
         // Grow by a 32nd at a time, not by doubling: the window's columns are most of the
         // stream's memory, and evicting from the front keeps their capacity. Columns this
         // large are mapped (`stream::malloc::one_arena`), so growing one remaps it without a copy.
-        let need = self.t.len() + b.t.len();
+        let need = self.t.len() + b.t.len() - s;
         if need > self.t.capacity() {
             let cap = need + need / 32;
             grow(&mut self.x, cap);
@@ -103,10 +104,10 @@ impl Columns {
                 .into_iter()
                 .map(|c| (base + u64::from(c.point), c)),
         );
-        self.x.extend(b.x);
-        self.y.extend(b.y);
-        self.z.extend(b.z);
-        self.t.extend(b.t);
+        self.x.extend_from_slice(&b.x[s..]);
+        self.y.extend_from_slice(&b.y[s..]);
+        self.z.extend_from_slice(&b.z[s..]);
+        self.t.extend_from_slice(&b.t[s..]);
         self.rho.extend(b.rho_deg);
         self.status.extend(b.status);
         self.scanline.extend(b.scanline);
@@ -148,7 +149,8 @@ pub struct SectionWindow<'a> {
     pub peak_points: usize,
     /// Points dropped by the time cap (`max_s`).
     pub capped_points: u64,
-    /// The point grid of the section last run, rebuilt in place for the next.
+    /// The point grid of the section last run, slid on to the next (its slabs of the
+    /// margin they share are kept).
     grid: PointGrid,
     /// Threads the sections left at the end of the stream are extracted on.
     finish_threads: usize,
@@ -273,7 +275,7 @@ impl<'a> SectionWindow<'a> {
     pub fn finish(&mut self) -> Vec<EdgeLine> {
         if self.single() {
             return self
-                .extract_range(0, self.cols.len())
+                .extract_range(0, self.cols.len(), None)
                 .into_iter()
                 .map(|(e, _)| e)
                 .collect();
@@ -309,8 +311,8 @@ impl<'a> SectionWindow<'a> {
             let s1 = s0 + l;
             let lo = self.cols.t.partition_point(|&t| self.station(t) < s0 - m);
             let hi = self.cols.t.partition_point(|&t| self.station(t) < s1 + m);
-            sections.push((s0, s1, lo, hi));
             from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
+            sections.push((s0, s1, lo, hi, from));
             s0 = s1;
         }
         let mut out = Vec::new();
@@ -320,19 +322,20 @@ impl<'a> SectionWindow<'a> {
                 let (cols, traj, route, bend) = (&self.cols, self.traj, &self.route, &self.bend);
                 let others: Vec<_> = group[1..]
                     .iter()
-                    .map(|&(_, _, lo, hi)| {
+                    .map(|&(_, _, lo, hi, _)| {
                         scope.spawn(move || {
                             if hi <= lo {
                                 return Vec::new();
                             }
                             let mut grid = PointGrid::build(&[], &[], 1.0, |_| false);
-                            extract_on(cols, traj, route, bend, &mut grid, lo, hi)
+                            extract_on(cols, traj, route, bend, &mut grid, lo, hi, None)
                         })
                     })
                     .collect();
-                let (_, _, lo, hi) = group[0];
+                let (_, _, lo, hi, next) = group[0];
                 found.push(if hi > lo {
-                    extract_on(cols, traj, route, bend, &mut self.grid, lo, hi)
+                    let cut = next.checked_sub(lo);
+                    extract_on(cols, traj, route, bend, &mut self.grid, lo, hi, cut)
                 } else {
                     Vec::new()
                 });
@@ -340,11 +343,11 @@ impl<'a> SectionWindow<'a> {
                     found.push(h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)));
                 }
             });
-            for (&(s0, s1, _, _), edges) in group.iter().zip(found) {
+            for (&(s0, s1, _, _, _), edges) in group.iter().zip(found) {
                 out.extend(self.close_section(edges, s0, s1));
             }
         }
-        if let Some(&(_, s1, _, _)) = sections.last() {
+        if let Some(&(_, s1, _, _, _)) = sections.last() {
             self.start = s1;
             let keep_from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
             self.cols.evict(keep_from);
@@ -359,14 +362,15 @@ impl<'a> SectionWindow<'a> {
         let s0 = self.start;
         let lo = self.cols.t.partition_point(|&t| self.station(t) < s0 - m);
         let hi = self.cols.t.partition_point(|&t| self.station(t) < s1 + m);
+        // Where the next section's points begin: the grid's new slabs are cut there.
+        let keep_from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
         let edges = if hi > lo {
-            self.extract_range(lo, hi)
+            self.extract_range(lo, hi, keep_from.checked_sub(lo))
         } else {
             Vec::new()
         };
         let closed = self.close_section(edges, s0, s1);
         self.start = s1;
-        let keep_from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
         self.cols.evict(keep_from);
         closed
     }
@@ -397,8 +401,14 @@ impl<'a> SectionWindow<'a> {
         }
     }
 
-    /// The bend method on the window's points `lo..hi`.
-    fn extract_range(&mut self, lo: usize, hi: usize) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
+    /// The bend method on the window's points `lo..hi`; the next section's points begin
+    /// `cut` points after `lo`.
+    fn extract_range(
+        &mut self,
+        lo: usize,
+        hi: usize,
+        cut: Option<usize>,
+    ) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
         extract_on(
             &self.cols,
             self.traj,
@@ -407,11 +417,15 @@ impl<'a> SectionWindow<'a> {
             &mut self.grid,
             lo,
             hi,
+            cut,
         )
     }
 }
 
-/// The bend method on the points `lo..hi` of `c`, indexed by `grid` (rebuilt in place).
+/// The bend method on the points `lo..hi` of `c`, indexed by `grid`: its slabs that lie in
+/// `lo..hi` are kept, the rest of the points indexed in new slabs cut `cut` points after
+/// `lo`, where the next section begins.
+#[allow(clippy::too_many_arguments)]
 fn extract_on(
     c: &Columns,
     traj: &Trajectory,
@@ -420,6 +434,7 @@ fn extract_on(
     grid: &mut PointGrid,
     lo: usize,
     hi: usize,
+    cut: Option<usize>,
 ) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
     let (glo, ghi) = (c.base + lo as u64, c.base + hi as u64);
     let cands: Vec<Candidate> = c
@@ -443,7 +458,7 @@ fn extract_on(
         trajectory: traj,
     };
     // One index for the tracker and the curb annotation.
-    bend::point_grid_into(grid, &input, bend);
+    bend::point_grid_slide(grid, &input, glo, cut, bend);
     let mut edges = bend::extract_edges_on_grid(&input, grid, route, bend);
     curb::annotate(&input, grid, route, edges.iter_mut().map(|(e, _)| e));
     edges
@@ -512,6 +527,7 @@ mod tests {
         let t: Vec<f64> = (0..n).map(|i| t0 + i as f64 / n as f64).collect();
         CoreBatch {
             base,
+            skip: 0,
             x: vec![0.0; n],
             y: vec![3.0; n],
             z: vec![0.0; n],
