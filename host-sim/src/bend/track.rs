@@ -1061,7 +1061,7 @@ mod tests {
         let mut line = 0u32;
         let mut x = 0.013;
         while x < 16.0 {
-            let toe = if line % 2 == 0 { 4.96 } else { 5.04 };
+            let toe = if line.is_multiple_of(2) { 4.96 } else { 5.04 };
             for k in 0..400 {
                 let y = k as f64 * 0.02;
                 let rho = if x < 7.0 {
