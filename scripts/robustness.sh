@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The robustness run: N random streets (`curbtrace simulate --scene random --seed S` for
 # S = FIRST_SEED .. FIRST_SEED + N - 1), both methods with their defaults, scored with
-# `curbtrace eval` (bend at the 50 mm buffer, qiu at 200 mm), summarised in
-# docs/robustness-accuracy.md with a picture of the worst place of the worst streets.
+# `curbtrace eval` (bend at the 50 mm buffer, qiu at 200 mm) against the reference and,
+# for comparison, against the strict reference (observed stretches not joined), summarised
+# in docs/robustness-accuracy.md with a picture of the worst place of the worst streets.
 #
 # Usage: scripts/robustness.sh N [FIRST_SEED]    (default: 30 streets from seed 1001)
 #
@@ -41,6 +42,8 @@ one_street() { # seed
     echo "wall_ms $(( ($(date +%s%N) - t1) / 1000000 ))" >> "$dir/$method.extract.txt"
     "$BIN" eval --reference "$dir/reference.geojson" --extracted "$dir/$method.geojson" \
       --buffer "$buffer" --json "$dir/$method.json" > "$dir/$method.eval.txt"
+    "$BIN" eval --reference "$dir/reference_strict.geojson" --extracted "$dir/$method.geojson" \
+      --buffer "$buffer" --json "$dir/$method.strict.json" > /dev/null
   done
   echo "seed $seed done in $(( ($(date +%s%N) - t0) / 1000000000 )) s"
 }

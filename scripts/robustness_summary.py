@@ -3,7 +3,8 @@
 
 Usage: scripts/robustness_summary.py OUT_DIR FIRST_SEED N ELAPSED_S BIN
 
-Reads OUT_DIR/seed-S/{simulate.txt, bend.json, qiu.json, *.extract.txt}, prints the page
+Reads OUT_DIR/seed-S/{simulate.txt, bend.json, qiu.json, *.strict.json, *.extract.txt},
+prints the page
 on stdout and draws the worst place of the worst streets with `BIN eval --picture` into
 docs/robustness/.
 """
@@ -51,7 +52,7 @@ def combine(metrics):
     return ratios(s["tp_m"], s["extracted_m"], s["reference_m"], s["matched_m"])
 
 
-def street(out, seed):
+def street(out, seed, suffix=""):
     d = out / f"seed-{seed}"
     sim = (d / "simulate.txt").read_text().splitlines()
     desc = sim[0] if sim else ""
@@ -67,7 +68,7 @@ def street(out, seed):
     m = re.search(r": (\d+) points", sim[1] if len(sim) > 1 else "")
     r["points"] = int(m.group(1)) if m else None
     for method in ["bend", "qiu"]:
-        p = d / f"{method}.json"
+        p = d / f"{method}{suffix}.json"
         if not p.exists():
             r[method] = None
             continue
@@ -168,6 +169,38 @@ def main():
         met = "not run" if v is None else ("yes" if ok else "no")
         p(f"| {name} | {fmt(v)} | {t.replace('>=', '≥').replace('<=', '≤')} | {met} |")
     p()
+    strict = [street(out, s["seed"], ".strict") for s in streets]
+    if any(s["bend"] or s["qiu"] for s in strict):
+        p("The reference joins two observed stretches of one toe at most 1 m apart")
+        p("([simulator.md](simulator.md), *Reference lines*). Against the strict reference, which")
+        p("keeps each observed stretch alone (`reference_strict.geojson`), the same extracted edges")
+        p("score:")
+        p()
+        p("| what | reference | strict reference |")
+        p("|---|---:|---:|")
+        sb = [s for s in strict if s["bend"]]
+        sq = [s for s in strict if s["qiu"]]
+        both = lambda f, a, b: f"| {f[0]} | {fmt(f[1](a))} | {fmt(f[1](b))} |"
+        rows = [
+            ("bend median total quality", lambda xs: med([s["bend"]["total"]["quality"] for s in xs])),
+            ("bend 10th percentile total quality", lambda xs: percentile([s["bend"]["total"]["quality"] for s in xs], 0.1)),
+            ("bend lowest total quality", lambda xs: min([s["bend"]["total"]["quality"] or 0.0 for s in xs], default=None)),
+            ("bend median completeness", lambda xs: med([s["bend"]["total"]["completeness"] for s in xs])),
+            ("bend 10th percentile correctness", lambda xs: percentile([s["bend"]["total"]["correctness"] for s in xs], 0.1)),
+            ("bend median curb-cut quality", lambda xs: med([s["bend"]["curb_cut"]["quality"] if s["bend"]["curb_cut"] else None for s in xs])),
+            ("bend median intersection quality", lambda xs: med([s["bend"]["intersection"]["quality"] if s["bend"]["intersection"] else None for s in xs])),
+        ]
+        for r in rows:
+            p(both(r, bend, sb))
+        qrows = [
+            ("qiu median completeness", lambda xs: med([s["qiu"]["total"]["completeness"] for s in xs])),
+            ("qiu median correctness", lambda xs: med([s["qiu"]["total"]["correctness"] for s in xs])),
+            ("qiu median far-side completeness", lambda xs: med([s["qiu"].get("side_" + (s["far"] or ""), {}).get("completeness") for s in xs])),
+        ]
+        if qiu and sq:
+            for r in qrows:
+                p(both(r, qiu, sq))
+        p()
     p("## bend, 50 mm buffer")
     p()
     p("| quality [%] | streets | min | 10th pct | median | mean |")

@@ -242,6 +242,16 @@ fn side_step(input: &BendInput, grid: &PointGrid, i: usize, dir: [f64; 2]) -> Op
 /// to follow a 4 m corner radius).
 const TURN_EMA: f64 = 0.2;
 
+/// Shortest horizontal span of the difference vector of Eq. 8, metres: the vector runs to
+/// the new vertex from the newest earlier vertex at least this far back (or the track's
+/// start), not from the last position. Consecutive vertices lie one step (0.1–0.15 m)
+/// apart and scatter across the toe by the point spacing or, on a virtual profile, by a
+/// few centimetres, so a one-step vector swings the search direction by 10–20°, and
+/// across a gap the track carries that swing off the curb; over half a metre the scatter
+/// turns it by a few degrees, and a 3 m corner radius makes it lag by under 5°. A vector
+/// from the last position would also start at an extrapolated one after a gap.
+const DIR_BASE_M: f64 = 0.5;
+
 /// Largest height difference between consecutive toes picked by ρ before the virtual
 /// profile is asked instead, metres: 0.15 m apart on a 10 % grade they differ by 15 mm.
 const MAX_TOE_DZ_M: f64 = 0.04;
@@ -754,10 +764,21 @@ fn track_one_way(
         if let Some(j) = claims.near(n, p[0], p[1], own) {
             return (picked, Some(j));
         }
-        let Some(u) = unit3([p[0] - cur[0], p[1] - cur[1], p[2] - cur[2]]) else {
+        let start_xyz = [input.x[s], input.y[s], input.z[s]];
+        let base = picked
+            .iter()
+            .rev()
+            .map(|v| v.1)
+            .chain(std::iter::once(start_xyz))
+            .find(|q| (p[0] - q[0]).hypot(p[1] - q[1]) >= DIR_BASE_M)
+            .unwrap_or(start_xyz);
+        let Some(u) = unit3([p[0] - base[0], p[1] - base[1], p[2] - base[2]])
+            .or_else(|| unit3([p[0] - cur[0], p[1] - cur[1], p[2] - cur[2]]))
+        else {
             break;
         };
-        // Eq. 8: v_k = a·v_{k−1} + b·v_{k−2} over the last two difference vectors.
+        // Eq. 8: v_k = a·v_{k−1} + b·v_{k−2} over the last two difference vectors, each
+        // spanning at least `DIR_BASE_M`.
         let v_new = unit3([
             params.a * u[0] + params.b * prev_u[0],
             params.a * u[1] + params.b * prev_u[1],
@@ -1066,6 +1087,51 @@ mod tests {
         let low = weak_line(12.0, 15.0);
         let far_low = farthest_x(&low, &params);
         assert!((11.7..12.5).contains(&far_low), "weak curb: x = {far_low}");
+    }
+
+    /// A toe line along y = 5 on flat ground (no step for a profile to find) seen by
+    /// scanlines across x every 0.11 m with points every 2 cm: ρ = 60° at one point per
+    /// scanline, 4 cm either side of the line by turns up to x = 7, none from x = 7 to
+    /// x = 7.6, and on the line from there to the end of the scan.
+    fn scattered_line() -> Corner {
+        let mut c = Corner::default();
+        let mut line = 0u32;
+        let mut x = 0.013;
+        while x < 16.0 {
+            let toe = if line.is_multiple_of(2) { 4.96 } else { 5.04 };
+            for k in 0..400 {
+                let y = k as f64 * 0.02;
+                let rho = if x < 7.0 {
+                    if (y - toe).abs() < 0.01 {
+                        60.0
+                    } else {
+                        0.0
+                    }
+                } else if x >= 7.6 && (y - 5.0).abs() < 0.01 {
+                    60.0
+                } else {
+                    0.0
+                };
+                c.push(x, y, 0.0, rho, line);
+            }
+            x += 0.11;
+            line += 1;
+        }
+        c
+    }
+
+    #[test]
+    fn a_track_crosses_a_gap_on_the_line_of_its_toes_not_the_last_steps_scatter() {
+        // The toes scatter 8 cm across the line from one scanline to the next: a
+        // direction from the last step alone points up to 30° off the line, and 0.6 m on
+        // it misses the toes beyond the gap; one over `DIR_BASE_M` stays on the line.
+        let c = scattered_line();
+        let t = track(&c, &BendParams::default());
+        let far = t.xyz.iter().map(|q| q[0]).fold(f64::MIN, f64::max);
+        assert!(far > 15.0, "stopped at x = {far}");
+        for q in &t.xyz {
+            assert!((q[1] - 5.0).abs() < 0.06, "vertex {q:?} off the line");
+        }
     }
 
     /// A curb along y = 5 (sidewalk 0.15 m up beyond it, ρ = 60° on the toe line) with a

@@ -1,6 +1,6 @@
 //! `curbtrace simulate --scene NAME -o DIR [--seed N] [--speed KMH] [--sensor SENSOR]
 //! [--duration S]`: simulates a mobile laser scanning scene and writes `points.laz`,
-//! `trajectory.csv`, `reference.geojson` (docs/simulator.md).
+//! `trajectory.csv`, `reference.geojson` and `reference_strict.geojson` (docs/simulator.md).
 
 use anyhow::Context;
 use curbtrace_host_sim::simulate::{self, spinning::SpinSensor, SpinOutput};

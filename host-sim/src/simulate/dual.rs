@@ -14,9 +14,8 @@
 //! observed), and `reference_scanner0.geojson`, `reference_scanner1.geojson` (what each
 //! observed alone).
 
-use super::reference::{self, Visibility};
 use super::scanner::{self, Return, ScannerConfig, VehicleBody};
-use super::{line_seed, simulate, SceneSpec, SimError, SimSummary, Simulation};
+use super::{line_seed, references, simulate, SceneSpec, SimError, SimSummary, Simulation};
 use crate::model::EdgeLine;
 use crate::mounts::{Mount, Mounts};
 use rand::SeedableRng;
@@ -133,18 +132,10 @@ pub fn simulate_two(
         .into_iter()
         .flatten()
         .collect();
-    let reference_of = |rs: &mut dyn Iterator<Item = &Return>| {
-        let mut vis = Visibility::new(&world.ground);
-        for r in rs {
-            if let Some(tc) = &r.toe {
-                vis.add(tc);
-            }
-        }
-        reference::reference_lines(&world.ground, &vis, &first.traj, world.spec.origin)
-    };
+    let reference_of = |rs: &mut dyn Iterator<Item = &Return>| references(world, rs, &first.traj);
     let ref0 = first.reference.clone();
-    let ref1 = reference_of(&mut second.iter());
-    let either = reference_of(&mut first.returns.iter().chain(&second));
+    let [ref1, _] = reference_of(&mut second.iter());
+    let [either, either_strict] = reference_of(&mut first.returns.iter().chain(&second));
     // Both in time order; scanner 1's pulses fall between scanner 0's.
     let (a, b) = (&first.returns, &second);
     let mut returns = Vec::with_capacity(a.len() + b.len());
@@ -165,6 +156,7 @@ pub fn simulate_two(
         sim: Simulation {
             returns,
             reference: either,
+            reference_strict: either_strict,
             ..first
         },
         channel,

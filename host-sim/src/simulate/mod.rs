@@ -126,6 +126,8 @@ pub struct Simulation {
     pub traj: Trajectory,
     /// Reference lines (CRS coordinates).
     pub reference: Vec<EdgeLine>,
+    /// Reference lines under the rule without joining gaps (`reference::Visibility::strict`).
+    pub reference_strict: Vec<EdgeLine>,
     /// Number of scan lines.
     pub lines: usize,
     /// Driven length during the scan, metres.
@@ -270,22 +272,37 @@ pub fn simulate_with(
         return Ok(simulate_revolutions(world, drive, sensor, seed, progress));
     }
     let (returns, lines) = cast_drive(&world, &drive, seed, progress);
-    let mut vis = reference::Visibility::new(&world.ground);
-    for r in &returns {
-        if let Some(tc) = &r.toe {
-            vis.add(tc);
-        }
-    }
-    let reference = reference::reference_lines(&world.ground, &vis, &drive.traj, world.spec.origin);
+    let [reference, reference_strict] = references(&world, &mut returns.iter(), &drive.traj);
     Ok(Simulation {
         world,
         returns,
         traj: drive.traj,
         reference,
+        reference_strict,
         lines,
         length_m: drive.length_m,
         scan: drive.scan,
     })
+}
+
+/// The reference lines of what `returns` observed, with gaps joined and without
+/// (`reference::Visibility::strict`).
+pub(crate) fn references(
+    world: &World,
+    returns: &mut dyn Iterator<Item = &scanner::Return>,
+    traj: &Trajectory,
+) -> [Vec<EdgeLine>; 2] {
+    let mut vis = reference::Visibility::new(&world.ground);
+    for r in returns {
+        if let Some(tc) = &r.toe {
+            vis.add(tc);
+        }
+    }
+    let origin = world.spec.origin;
+    [
+        reference::reference_lines(&world.ground, &vis, traj, origin),
+        reference::reference_lines(&world.ground, &vis.strict(), traj, origin),
+    ]
 }
 
 /// The scene's profiler over `drive`: every line from its own generator seeded by
@@ -364,26 +381,21 @@ fn simulate_revolutions(
         b.finish_and_clear();
     }
     let returns: Vec<scanner::Return> = per_rev.into_iter().flatten().collect();
-    let mut vis = reference::Visibility::new(&world.ground);
-    for r in &returns {
-        if let Some(tc) = &r.toe {
-            vis.add(tc);
-        }
-    }
-    let reference = reference::reference_lines(&world.ground, &vis, &drive.traj, world.spec.origin);
+    let [reference, reference_strict] = references(&world, &mut returns.iter(), &drive.traj);
     Simulation {
         world,
         returns,
         traj: drive.traj,
         reference,
+        reference_strict,
         lines: revs,
         length_m: drive.length_m,
         scan: drive.scan,
     }
 }
 
-/// Simulates a scene and writes `points.laz`, `trajectory.csv` and `reference.geojson`
-/// into `out_dir` (created if missing).
+/// Simulates a scene and writes `points.laz`, `trajectory.csv`, `reference.geojson` and
+/// `reference_strict.geojson` into `out_dir` (created if missing).
 pub fn run(
     spec: &SceneSpec,
     seed: u64,
@@ -447,6 +459,8 @@ pub fn run_with(
     write::write_trajectory(&trajectory_path, &sim.traj, origin)?;
     let crs = write::crs_for(spec.epsg);
     write::write_reference(&reference_path, &sim.reference, &crs)?;
+    let strict_path = out_dir.join("reference_strict.geojson");
+    write::write_reference(&strict_path, &sim.reference_strict, &crs)?;
     Ok(SimSummary::of(
         spec,
         &sim,

@@ -14,9 +14,8 @@
 //! `reference_pass0.geojson`, `reference_pass1.geojson` (what each observed alone); `side`
 //! is relative to pass 0's direction in all three.
 
-use super::reference::{self, Visibility};
 use super::scanner::Return;
-use super::{cast_drive, drive, simulate, SceneSpec, SimError, SimSummary, Simulation};
+use super::{cast_drive, drive, references, simulate, SceneSpec, SimError, SimSummary, Simulation};
 use crate::io::trajectory::Trajectory;
 use crate::model::EdgeLine;
 use rand::{Rng, SeedableRng};
@@ -64,17 +63,9 @@ pub fn simulate_passes(
     let speed = speed_kmh.unwrap_or(spec.speed_kmh);
     let back = drive::plan_pass(world, speed, seed ^ PASS_SEED, true, first.scan.1 + TURN_S);
     let (mut second, lines) = cast_drive(world, &back, seed ^ PASS_SEED, progress);
-    let reference_of = |rs: &mut dyn Iterator<Item = &Return>| {
-        let mut vis = Visibility::new(&world.ground);
-        for r in rs {
-            if let Some(tc) = &r.toe {
-                vis.add(tc);
-            }
-        }
-        reference::reference_lines(&world.ground, &vis, &first.traj, world.spec.origin)
-    };
-    let ref1 = reference_of(&mut second.iter());
-    let either = reference_of(&mut first.returns.iter().chain(&second));
+    let reference_of = |rs: &mut dyn Iterator<Item = &Return>| references(world, rs, &first.traj);
+    let [ref1, _] = reference_of(&mut second.iter());
+    let [either, either_strict] = reference_of(&mut first.returns.iter().chain(&second));
     let angle = ChaCha8Rng::seed_from_u64(seed ^ PASS_SEED).gen_range(0.0..std::f64::consts::TAU);
     let off = [offset_m * angle.cos(), offset_m * angle.sin()];
     for r in &mut second {
@@ -96,6 +87,7 @@ pub fn simulate_passes(
             returns,
             traj: Trajectory { samples },
             reference: either,
+            reference_strict: either_strict,
             lines: first.lines + lines,
             length_m: first.length_m + back.length_m,
             scan: (first.scan.0, back.scan.1),

@@ -12,6 +12,13 @@
 //! stretches hidden behind parked cars or never reached (far down a side street) drop out,
 //! and stretches seen before the start or after the end of the drive stay in.
 //!
+//! **Two observed stretches of one toe at most [`JOIN_M`] apart are joined**, as a surveyor
+//! draws one line through a curb sampled every metre: scanlines that cross a far curb at a
+//! grazing angle, or a spinning sensor's rings crossing it once per revolution, observe the
+//! toe in short pieces that the window alone would leave apart. Longer gaps (a parked car
+//! is 4–5 m long) stay holes. [`Visibility::strict`] gives the rule without joining, written
+//! beside the reference as `reference_strict.geojson`.
+//!
 //! A segment's category is its vertices' category, or the special one (curb cut,
 //! intersection, bus bay) when they differ. Intersection covers the corner arcs and the
 //! side street's curbs. The side is the sign of the segment midpoint's lateral offset x′
@@ -26,13 +33,17 @@ use crate::model::{Category, CurbDetail, EdgeLine, Side};
 pub const WINDOW_M: f64 = 0.15;
 /// Distance band across the toe, metres.
 pub const BAND_M: f64 = 0.15;
+/// Longest gap between two observed stretches of one toe that the reference joins, metres.
+pub const JOIN_M: f64 = 1.0;
 const BIN_M: f64 = 0.05;
 
 /// Evidence per toe: counts of road-side and curb-side returns in 5 cm bins along it.
+#[derive(Clone)]
 pub struct Visibility {
     along: Vec<Vec<f64>>,
     road: Vec<Vec<u32>>,
     curb: Vec<Vec<u32>>,
+    join_m: f64,
 }
 
 impl Visibility {
@@ -56,7 +67,14 @@ impl Visibility {
             road: along.iter().map(bins).collect(),
             curb: along.iter().map(bins).collect(),
             along,
+            join_m: JOIN_M,
         }
+    }
+
+    /// The same evidence under the rule without joining gaps: each observed stretch alone.
+    pub fn strict(mut self) -> Self {
+        self.join_m = 0.0;
+        self
     }
 
     /// Evidence on both sides of every bin: every toe vertex is kept. The reference
@@ -97,14 +115,33 @@ impl Visibility {
         };
         let (pr, pc) = (prefix(&self.road[ti]), prefix(&self.curb[ti]));
         let n = self.road[ti].len();
-        self.along[ti]
+        let along = &self.along[ti];
+        let mut kept: Vec<bool> = along
             .iter()
             .map(|&a| {
                 let lo = (((a - WINDOW_M) / BIN_M).floor().max(0.0) as usize).min(n);
                 let hi = ((((a + WINDOW_M) / BIN_M).floor() as usize) + 1).min(n);
                 pr[hi] > pr[lo] && pc[hi] > pc[lo]
             })
-            .collect()
+            .collect();
+        join_gaps(&mut kept, along, self.join_m);
+        kept
+    }
+}
+
+/// Marks kept every vertex between two kept vertices at most `join_m` apart along the toe.
+fn join_gaps(kept: &mut [bool], along: &[f64], join_m: f64) {
+    let mut last: Option<usize> = None;
+    for v in 0..kept.len() {
+        if !kept[v] {
+            continue;
+        }
+        if let Some(u) = last {
+            if v > u + 1 && along[v] - along[u] <= join_m {
+                kept[u + 1..v].fill(true);
+            }
+        }
+        last = Some(v);
     }
 }
 
@@ -221,4 +258,37 @@ pub fn reference_lines(
         flush(&mut cur, &mut out);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::join_gaps;
+
+    /// Vertices every 0.1 m; `holes` are index ranges left unobserved.
+    fn joined(holes: &[std::ops::Range<usize>], join_m: f64) -> Vec<bool> {
+        let along: Vec<f64> = (0..100).map(|i| i as f64 * 0.1).collect();
+        let mut kept = vec![true; along.len()];
+        for h in holes {
+            kept[h.clone()].fill(false);
+        }
+        join_gaps(&mut kept, &along, join_m);
+        kept
+    }
+
+    #[test]
+    fn gaps_up_to_the_join_length_are_joined_and_longer_ones_stay() {
+        // A hole of 8 vertices lies 0.9 m between its kept neighbours; one of 20, 2.1 m.
+        let k = joined(&[10..18, 40..60], 1.0);
+        assert!(k[10..18].iter().all(|&b| b), "a 0.9 m gap is joined");
+        assert!(k[40..60].iter().all(|&b| !b), "a 2.1 m gap stays a hole");
+        // The ends of the toe are not gaps: nothing observed before the first kept vertex.
+        let k = joined(&[0..5, 95..100], 1.0);
+        assert!(k[0..5].iter().chain(&k[95..100]).all(|&b| !b));
+    }
+
+    #[test]
+    fn the_strict_rule_joins_nothing() {
+        let k = joined(&[10..12], 0.0);
+        assert!(k[10..12].iter().all(|&b| !b));
+    }
 }
