@@ -19,6 +19,7 @@ pub mod postfilter;
 pub mod profile;
 pub mod route;
 pub mod seed;
+pub mod shadow;
 pub mod sparse;
 pub mod track;
 
@@ -152,7 +153,8 @@ pub fn extract_edges_on_grid(
             .then(a.interval.cmp(&b.interval))
             .then(a.point.cmp(&b.point))
     });
-    let tracks = track::track_edges(&input, grid, &seeds, params);
+    let mut tracks = track::track_edges(&input, grid, &seeds, params);
+    shadow::place_shadowed_toes(&input, grid, &mut tracks, params);
     let tracks = postfilter::remove_short(&input, tracks, params);
     let tracks = postfilter::remove_under_objects(&input, grid, tracks, params);
     let tracks = if params.roadway_filter {
