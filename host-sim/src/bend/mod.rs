@@ -1,7 +1,8 @@
 //! The bend-angle method's host half (Honma et al. §2.6–2.7): seeding by RANSAC per
 //! interval ([`seed`]), tracking by the energy of Eq. 4–8 ([`track`]), virtual toes
-//! moved across the curb's shadow ([`shadow`]), post-filters and the edges' properties ([`postfilter`]), bridges between tracks that continue each other
-//! ([`bridge`]). It reads the core's output as it is (its ρ and
+//! moved across the curb's shadow ([`shadow`]), post-filters and the edges' properties
+//! ([`postfilter`]), bridges between tracks that continue each other ([`bridge`]). It
+//! reads the core's output as it is (its ρ and
 //! its candidates) and never recomputes them.
 //!
 //! Everything here is sequential and uses only seeded randomness, so the output is the same
