@@ -1,7 +1,8 @@
 //! The bend-angle method's host half (Honma et al. §2.6–2.7): seeding by RANSAC per
-//! interval ([`seed`]), tracking by the energy of Eq. 4–8 ([`track`]), post-filters and
-//! the edges' properties ([`postfilter`]), bridges between tracks that continue each other
-//! ([`bridge`]). It reads the core's output as it is (its ρ and
+//! interval ([`seed`]), tracking by the energy of Eq. 4–8 ([`track`]), virtual toes
+//! moved across the curb's shadow ([`shadow`]), post-filters and the edges' properties
+//! ([`postfilter`]), bridges between tracks that continue each other ([`bridge`]). It
+//! reads the core's output as it is (its ρ and
 //! its candidates) and never recomputes them.
 //!
 //! Everything here is sequential and uses only seeded randomness, so the output is the same
@@ -20,6 +21,7 @@ pub mod postfilter;
 pub mod profile;
 pub mod route;
 pub mod seed;
+pub mod shadow;
 pub mod sparse;
 pub mod track;
 
@@ -171,7 +173,8 @@ pub fn extract_edges_on_grid(
             .then(a.interval.cmp(&b.interval))
             .then(a.point.cmp(&b.point))
     });
-    let tracks = track::track_edges(&input, grid, &seeds, params);
+    let mut tracks = track::track_edges(&input, grid, &seeds, params);
+    shadow::place_shadowed_toes(&input, grid, &mut tracks, params);
     let tracks = postfilter::remove_short(&input, tracks, params);
     let tracks = postfilter::remove_under_objects(&input, grid, tracks, params);
     let tracks = if params.roadway_filter {

@@ -51,6 +51,105 @@ pub fn profile_toe(
     half_l: f64,
     params: &BendParams,
 ) -> Option<ProfileToe> {
+    profile_split(input, grid, centre, along, up, half_l, params).map(|s| s.toe)
+}
+
+/// The toe of [`profile_toe`] with the offsets across the profile it was split at.
+#[derive(Clone, Copy, Debug)]
+struct Split {
+    toe: ProfileToe,
+    /// The toe's offset across, half-way between `last_low` and `first_high`.
+    at: f64,
+    /// Offset of the last road point before the toe.
+    last_low: f64,
+    /// Offset of the first curb point after it.
+    first_high: f64,
+}
+
+/// Narrowest gap between the last road and the first curb point of a profile that can be
+/// the curb's shadow rather than the face, metres.
+const SHADOW_MIN_GAP_M: f64 = 0.1;
+
+/// How far across, towards the curb, a toe that [`profile_toe`] finds on the profile
+/// through `centre` lies from where it puts it, with that toe: half of the way from the
+/// middle of the gap between the road and the curb points to the first curb point where
+/// that gap is the curb's shadow ([`in_shadow`]), else 0.
+///
+/// Across a shadow the returns beside the toe are the curb's (the scanner looks at the
+/// curb from behind and sees its top up to the arris), while the road before it is
+/// hidden for the shadow's length, so the middle of the gap lies on the road. The toe
+/// lies between the middle and the first curb return: the arris lies a face's width
+/// behind the toe, and the first return up to a point spacing behind the arris.
+pub fn shadow_shift(
+    input: &BendInput,
+    grid: &PointGrid,
+    centre: [f64; 3],
+    along: [f64; 2],
+    up: f64,
+    half_l: f64,
+    params: &BendParams,
+) -> Option<(ProfileToe, f64)> {
+    let s = profile_split(input, grid, centre, along, up, half_l, params)?;
+    let shadow = s.first_high - s.last_low >= SHADOW_MIN_GAP_M
+        && in_shadow(
+            input,
+            grid,
+            centre,
+            along,
+            up,
+            half_l,
+            params,
+            s.at,
+            &[s.last_low, s.first_high],
+        );
+    let shift = if shadow {
+        0.5 * (s.first_high - s.at)
+    } else {
+        0.0
+    };
+    Some((s.toe, shift))
+}
+
+/// Whether the scanner stood on the curb's side of the toe (offset `toe` across) when it
+/// measured the profile's points at the offsets `at`: there the raised curb hides the road
+/// just past the toe (the curb's shadow). `false` where the trajectory does not cover a
+/// point's time.
+#[allow(clippy::too_many_arguments)]
+fn in_shadow(
+    input: &BendInput,
+    grid: &PointGrid,
+    centre: [f64; 3],
+    along: [f64; 2],
+    up: f64,
+    half_l: f64,
+    params: &BendParams,
+    toe: f64,
+    at: &[f64],
+) -> bool {
+    let n = [-along[1] * up, along[0] * up];
+    let (mut any, mut all) = (false, true);
+    for_each_on_profile(input, grid, centre, along, up, half_l, params, |i, c, _| {
+        if at.contains(&c) {
+            any = true;
+            all &= input
+                .trajectory
+                .pose_at(input.t[i])
+                .is_some_and(|p| (p.x - centre[0]) * n[0] + (p.y - centre[1]) * n[1] > toe);
+        }
+    });
+    any && all
+}
+
+/// [`profile_toe`]'s search, with the offsets it split the profile at.
+fn profile_split(
+    input: &BendInput,
+    grid: &PointGrid,
+    centre: [f64; 3],
+    along: [f64; 2],
+    up: f64,
+    half_l: f64,
+    params: &BendParams,
+) -> Option<Split> {
     let half_w = params.profile_half_width_m;
     let n = [-along[1] * up, along[0] * up];
     const MIN_SIDE: usize = 4;
@@ -130,13 +229,18 @@ pub fn profile_toe(
         .map(|p| p.2)
         .collect();
     let a = near.iter().sum::<f64>() / near.len().max(1) as f64;
-    Some(ProfileToe {
-        xyz: [
-            centre[0] + a * along[0] + toe * n[0],
-            centre[1] + a * along[1] + toe * n[1],
-            z,
-        ],
-        step_m: step,
+    Some(Split {
+        toe: ProfileToe {
+            xyz: [
+                centre[0] + a * along[0] + toe * n[0],
+                centre[1] + a * along[1] + toe * n[1],
+                z,
+            ],
+            step_m: step,
+        },
+        at: toe,
+        last_low: prof[k - 1].0,
+        first_high: prof[k].0,
     })
 }
 

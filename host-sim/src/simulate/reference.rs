@@ -264,12 +264,12 @@ pub fn reference_lines(
 mod tests {
     use super::join_gaps;
 
-    /// Vertices every 0.1 m; `holes` are index ranges left unobserved.
-    fn joined(holes: &[std::ops::Range<usize>], join_m: f64) -> Vec<bool> {
+    /// Vertices every 0.1 m; `holes` are `(first, end)` index ranges left unobserved.
+    fn joined(holes: &[(usize, usize)], join_m: f64) -> Vec<bool> {
         let along: Vec<f64> = (0..100).map(|i| i as f64 * 0.1).collect();
         let mut kept = vec![true; along.len()];
-        for h in holes {
-            kept[h.clone()].fill(false);
+        for &(a, b) in holes {
+            kept[a..b].fill(false);
         }
         join_gaps(&mut kept, &along, join_m);
         kept
@@ -278,17 +278,17 @@ mod tests {
     #[test]
     fn gaps_up_to_the_join_length_are_joined_and_longer_ones_stay() {
         // A hole of 8 vertices lies 0.9 m between its kept neighbours; one of 20, 2.1 m.
-        let k = joined(&[10..18, 40..60], 1.0);
+        let k = joined(&[(10, 18), (40, 60)], 1.0);
         assert!(k[10..18].iter().all(|&b| b), "a 0.9 m gap is joined");
         assert!(k[40..60].iter().all(|&b| !b), "a 2.1 m gap stays a hole");
         // The ends of the toe are not gaps: nothing observed before the first kept vertex.
-        let k = joined(&[0..5, 95..100], 1.0);
+        let k = joined(&[(0, 5), (95, 100)], 1.0);
         assert!(k[0..5].iter().chain(&k[95..100]).all(|&b| !b));
     }
 
     #[test]
     fn the_strict_rule_joins_nothing() {
-        let k = joined(&[10..12], 0.0);
+        let k = joined(&[(10, 12)], 0.0);
         assert!(k[10..12].iter().all(|&b| !b));
     }
 }
