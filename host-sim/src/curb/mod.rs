@@ -132,6 +132,9 @@ fn sections_along(input: &BendInput, grid: &PointGrid, route: &Route, e: &mut Ed
                 }
             },
         );
+        // The grid hands points on in an order that depends on how the window was cut;
+        // sorted, the fit's sums do not, and a file cut into tasks gives the same bits.
+        prof.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
         raw.push(profile::fit(&prof));
     }
     // Arc length along the edge, for the filter.
