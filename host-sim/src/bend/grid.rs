@@ -357,19 +357,24 @@ impl Slab {
         starts[0] = 0;
     }
 
+    /// The cells `lo..=hi` (offsets from the slab's origin, metres) cover along an axis of
+    /// `n` cells, clamped to it; `None` where the span misses the axis.
+    #[inline]
+    fn span(&self, lo: f64, hi: f64, n: usize) -> Option<(usize, usize)> {
+        let a = floor(lo / self.cell_m);
+        let b = floor(hi / self.cell_m);
+        if b < 0.0 || a >= n as f64 {
+            return None;
+        }
+        Some((a.max(0.0) as usize, (b as usize).min(n - 1)))
+    }
+
     /// Calls `f(i)` for the points of the cells that the disc of `r` around `(px, py)`
     /// and `rect` both touch, row by row (each row's cells from the rectangle's extent in
     /// that row's band, a micrometre wider either way than the float cell bounds need).
     fn for_each_in_rows(&self, px: f64, py: f64, r: f64, rect: &Rect, mut f: impl FnMut(usize)) {
         const SLACK_M: f64 = 1e-6;
-        let span = |lo: f64, hi: f64, n: usize| -> Option<(usize, usize)> {
-            let a = floor(lo / self.cell_m);
-            let b = floor(hi / self.cell_m);
-            if b < 0.0 || a >= n as f64 {
-                return None;
-            }
-            Some((a.max(0.0) as usize, (b as usize).min(n - 1)))
-        };
+        let span = |lo: f64, hi: f64, n: usize| self.span(lo, hi, n);
         let Some((ax, bx)) = span(px - r - self.x0, px + r - self.x0, self.nx) else {
             return;
         };
@@ -411,14 +416,7 @@ impl Slab {
         r: f64,
         mut f: impl FnMut(usize),
     ) {
-        let span = |lo: f64, hi: f64, n: usize| -> Option<(usize, usize)> {
-            let a = floor(lo / self.cell_m);
-            let b = floor(hi / self.cell_m);
-            if b < 0.0 || a >= n as f64 {
-                return None;
-            }
-            Some((a.max(0.0) as usize, (b as usize).min(n - 1)))
-        };
+        let span = |lo: f64, hi: f64, n: usize| self.span(lo, hi, n);
         let Some((ax, bx)) = span(px - r - self.x0, px + r - self.x0, self.nx) else {
             return;
         };
