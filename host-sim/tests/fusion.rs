@@ -54,6 +54,14 @@ fn doubled_m(lines: &[EdgeLine]) -> f64 {
     doubled
 }
 
+/// The strict reference is written beside `reference` in `dir`, and joining only adds length.
+fn assert_strict_within(reference: &[EdgeLine], dir: &std::path::Path) {
+    let (strict, _) = read_geojson(&dir.join("reference_strict.geojson")).unwrap();
+    let length = |lines: &[EdgeLine]| lines.iter().map(EdgeLine::length_m).sum::<f64>();
+    assert!(!strict.is_empty());
+    assert!(length(&strict) <= length(reference) + 1e-9);
+}
+
 #[test]
 fn two_scanners_fused_cover_what_either_covers_once() {
     let dir = tempfile::tempdir().unwrap();
@@ -66,6 +74,7 @@ fn two_scanners_fused_cover_what_either_covers_once() {
     };
     assert_eq!(cfg.scanners.get(1).yaw_deg, -cfg.scanners.get(0).yaw_deg);
     let (reference, _) = read_geojson(&s.reference_path).unwrap();
+    assert_strict_within(&reference, dir.path());
     let run = |scanner: Option<u16>| {
         let opts = ExtractOptions {
             scanner,
@@ -124,6 +133,7 @@ fn two_passes_fused_give_one_edge_per_curb_at_least_as_good_as_either() {
         curbtrace_host_sim::simulate::passes::run_passes(&spec, 5, None, 0.1, dir.path(), false)
             .unwrap();
     let (reference, _) = read_geojson(&s.reference_path).unwrap();
+    assert_strict_within(&reference, dir.path());
     let run = |pass: Option<u16>| {
         let opts = ExtractOptions {
             pass,

@@ -121,18 +121,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         s.simulate_s,
         s.write_s
     );
-    // One profiler, one pass: the strict reference is written beside the reference.
-    let strict = if (args.scanners, args.passes) == (1, 1) {
-        let path = s.reference_path.with_file_name("reference_strict.geojson");
-        format!(", {}", path.display())
-    } else {
-        String::new()
-    };
+    let strict = s.reference_path.with_file_name("reference_strict.geojson");
     println!(
-        "wrote {}, {}, {}{strict}",
+        "wrote {}, {}, {}, {}",
         s.points_path.display(),
         s.trajectory_path.display(),
-        s.reference_path.display()
+        s.reference_path.display(),
+        strict.display()
     );
     Ok(())
 }

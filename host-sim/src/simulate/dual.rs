@@ -166,7 +166,8 @@ pub fn simulate_two(
 }
 
 /// Simulates `spec` with two scanners and writes `points.laz`, `trajectory.csv`,
-/// `mounts.toml` and the three references into `out_dir`.
+/// `mounts.toml`, the reference, the strict reference and each scanner's reference into
+/// `out_dir`.
 pub fn run_two(
     spec: &SceneSpec,
     seed: u64,
@@ -182,20 +183,6 @@ pub fn run_two(
     std::fs::create_dir_all(out_dir).map_err(io_err(out_dir))?;
     let two = simulate_two(spec, seed, speed_kmh, progress)?;
     let simulate_s = start.elapsed().as_secs_f64();
-    let sim = &two.sim;
-    let origin = sim.world.spec.origin;
-    let points_path = out_dir.join("points.laz");
-    let trajectory_path = out_dir.join("trajectory.csv");
-    let reference_path = out_dir.join("reference.geojson");
-    super::write::write_points_channels(
-        &points_path,
-        &sim.returns,
-        Some(&two.channel),
-        origin,
-        spec.epsg,
-        None,
-    )?;
-    super::write::write_trajectory(&trajectory_path, &sim.traj, origin)?;
     let mounts_path = out_dir.join("mounts.toml");
     let text = format!(
         "# Mounts of the simulated scanners relative to the trajectory (scanner 0's origin):\n# lever arm forward, left, up in metres; the angles are the scan plane's yaw and tilt.\n{}",
@@ -203,21 +190,14 @@ pub fn run_two(
     );
     std::fs::write(&mounts_path, text).map_err(io_err(&mounts_path))?;
     let crs = super::write::crs_for(spec.epsg);
-    super::write::write_reference(&reference_path, &sim.reference, &crs)?;
     for (name, lines) in ["reference_scanner0.geojson", "reference_scanner1.geojson"]
         .into_iter()
         .zip(&two.reference_each)
     {
         super::write::write_reference(&out_dir.join(name), lines, &crs)?;
     }
-    Ok(SimSummary::of(
-        spec,
-        sim,
-        start,
-        simulate_s,
-        [points_path, trajectory_path, reference_path],
-        crs,
-    ))
+    let channels = Some(two.channel.as_slice());
+    super::write_run(spec, &two.sim, channels, None, out_dir, start, simulate_s)
 }
 
 #[cfg(test)]

@@ -450,12 +450,35 @@ pub fn run_with(
     })?;
     let sim = simulate_with(spec, seed, speed_kmh, spin.map(|s| s.sensor), progress)?;
     let simulate_s = start.elapsed().as_secs_f64();
+    let ring = spin.and_then(|s| s.ring_name);
+    write_run(spec, &sim, None, ring, out_dir, start, simulate_s)
+}
+
+/// Writes `sim`'s `points.laz` (return `i` on scanner channel `channels[i]` when given, the
+/// ring as the extra-bytes dimension `ring` when given), `trajectory.csv`,
+/// `reference.geojson` and `reference_strict.geojson` into `out_dir`, and sums the run up:
+/// it started at `start` and spent its first `simulate_s` seconds simulating.
+pub(crate) fn write_run(
+    spec: &SceneSpec,
+    sim: &Simulation,
+    channels: Option<&[u8]>,
+    ring: Option<&str>,
+    out_dir: &Path,
+    start: Instant,
+    simulate_s: f64,
+) -> Result<SimSummary, SimError> {
     let origin = sim.world.spec.origin;
     let points_path = out_dir.join("points.laz");
     let trajectory_path = out_dir.join("trajectory.csv");
     let reference_path = out_dir.join("reference.geojson");
-    let ring = spin.and_then(|s| s.ring_name);
-    write::write_points_with(&points_path, &sim.returns, origin, spec.epsg, ring)?;
+    write::write_points_channels(
+        &points_path,
+        &sim.returns,
+        channels,
+        origin,
+        spec.epsg,
+        ring,
+    )?;
     write::write_trajectory(&trajectory_path, &sim.traj, origin)?;
     let crs = write::crs_for(spec.epsg);
     write::write_reference(&reference_path, &sim.reference, &crs)?;
@@ -463,7 +486,7 @@ pub fn run_with(
     write::write_reference(&strict_path, &sim.reference_strict, &crs)?;
     Ok(SimSummary::of(
         spec,
-        &sim,
+        sim,
         start,
         simulate_s,
         [points_path, trajectory_path, reference_path],

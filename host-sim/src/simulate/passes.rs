@@ -98,8 +98,8 @@ pub fn simulate_passes(
     })
 }
 
-/// Simulates `spec` driven twice and writes `points.laz`, `trajectory.csv` and the three
-/// references into `out_dir`.
+/// Simulates `spec` driven twice and writes `points.laz`, `trajectory.csv`, the
+/// reference, the strict reference and each pass's reference into `out_dir`.
 pub fn run_passes(
     spec: &SceneSpec,
     seed: u64,
@@ -115,29 +115,14 @@ pub fn run_passes(
     })?;
     let two = simulate_passes(spec, seed, speed_kmh, offset_m, progress)?;
     let simulate_s = start.elapsed().as_secs_f64();
-    let sim = &two.sim;
-    let origin = sim.world.spec.origin;
-    let points_path = out_dir.join("points.laz");
-    let trajectory_path = out_dir.join("trajectory.csv");
-    let reference_path = out_dir.join("reference.geojson");
-    super::write::write_points_with(&points_path, &sim.returns, origin, spec.epsg, None)?;
-    super::write::write_trajectory(&trajectory_path, &sim.traj, origin)?;
     let crs = super::write::crs_for(spec.epsg);
-    super::write::write_reference(&reference_path, &sim.reference, &crs)?;
     for (name, lines) in ["reference_pass0.geojson", "reference_pass1.geojson"]
         .into_iter()
         .zip(&two.reference_each)
     {
         super::write::write_reference(&out_dir.join(name), lines, &crs)?;
     }
-    Ok(SimSummary::of(
-        spec,
-        sim,
-        start,
-        simulate_s,
-        [points_path, trajectory_path, reference_path],
-        crs,
-    ))
+    super::write_run(spec, &two.sim, None, None, out_dir, start, simulate_s)
 }
 
 #[cfg(test)]
