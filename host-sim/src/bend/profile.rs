@@ -40,7 +40,7 @@ pub struct ProfileToe {
 /// by a line, and the toe is accepted only as a curb: a step of at least
 /// `profile_min_step_m` (and under the search half-height) between the two lines at the
 /// toe, both parts ground-like (slopes under `profile_max_slope`, so a curb cut's ramp is
-/// no step), the lines' RMS under a quarter of the step, ground within 0.15 m on both
+/// no step; a road part falling to the toe under `profile_max_road_fall`), the lines' RMS under a quarter of the step, ground within 0.15 m on both
 /// sides of the toe, and the toe within `profile_half_width_m` − 0.15 m of the centre.
 pub fn profile_toe(
     input: &BendInput,
@@ -203,9 +203,10 @@ fn profile_split(
     let (ha, hb, he) = line(hi, m);
     let step = (ha + hb * toe) - (la + lb * toe);
     let rms = ((le + he) / (lo + m - hi) as f64).sqrt();
-    // Both parts must be ground, not a ramp or a car's flank.
+    // Both parts must be ground, not a ramp or a car's flank; the road may fall to the
+    // toe more steeply (a gutter, a grade across a side street's curb).
     let max_slope = params.profile_max_slope;
-    if lb.abs() > max_slope || hb.abs() > max_slope {
+    if lb > max_slope || -lb > params.profile_max_road_fall || hb.abs() > max_slope {
         return None;
     }
     if step < params.profile_min_step_m || step > params.search_half_height_m {
