@@ -470,6 +470,59 @@ pub fn cut_toe(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::trajectory::Trajectory;
+
+    /// The toe on a profile across a curb along y at x = 0 (0.15 m up towards +x, the
+    /// sidewalk rising 2 % away from it), points every 2 cm across and 5 cm along, the road
+    /// at `road(x)` for x < 0.
+    fn toe_beside(road: impl Fn(f64) -> f64, params: &BendParams) -> Option<ProfileToe> {
+        let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..45 {
+            for j in 0..13 {
+                let px = -0.45 + 0.02 * f64::from(i) + 0.01;
+                x.push(px);
+                y.push(-0.3 + 0.05 * f64::from(j));
+                z.push(if px < 0.0 { road(px) } else { 0.15 + 0.02 * px });
+            }
+        }
+        let n = x.len();
+        let (t, rho) = (vec![0.0; n], vec![0.0f32; n]);
+        let status = vec![Some(PointStatus::Kept); n];
+        let scanline = vec![0u32; n];
+        let trajectory = Trajectory::default();
+        let input = BendInput {
+            x: &x,
+            y: &y,
+            z: &z,
+            t: &t,
+            rho_deg: &rho,
+            status: &status,
+            scanline: &scanline,
+            candidates: &[],
+            trajectory: &trajectory,
+        };
+        let grid = PointGrid::build(&x, &y, 0.1, |_| true);
+        // Walking along +y with the curb on the right (+x).
+        profile_toe(&input, &grid, [0.0, 0.0, 0.0], [0.0, 1.0], -1.0, 0.15, params)
+    }
+
+    #[test]
+    fn a_road_falling_steeply_to_the_toe_still_shows_it_and_a_rising_one_does_not() {
+        let params = BendParams::default();
+        // A gutter on a grade: the road falls 12 % to the toe.
+        let toe = toe_beside(|x| -0.12 * x, &params).expect("a toe beside a 12 % fall");
+        assert!(toe.xyz[0].abs() < 0.03, "{toe:?}");
+        assert!((toe.step_m - 0.15).abs() < 0.02, "{toe:?}");
+        // The same ground with the fall held to the rising limit: no toe.
+        let strict = BendParams {
+            profile_max_road_fall: params.profile_max_slope,
+            ..BendParams::default()
+        };
+        assert!(toe_beside(|x| -0.12 * x, &strict).is_none());
+        // A road rising 12 % to the toe, or falling 20 %, is no curb's road.
+        assert!(toe_beside(|x| 0.12 * x + 0.05, &params).is_none());
+        assert!(toe_beside(|x| -0.2 * x, &params).is_none());
+    }
 
     #[test]
     fn sort_across_is_the_stable_sort_by_total_cmp() {
