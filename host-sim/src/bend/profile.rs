@@ -503,7 +503,15 @@ mod tests {
         };
         let grid = PointGrid::build(&x, &y, 0.1, |_| true);
         // Walking along +y with the curb on the right (+x).
-        profile_toe(&input, &grid, [0.0, 0.0, 0.0], [0.0, 1.0], -1.0, 0.15, params)
+        profile_toe(
+            &input,
+            &grid,
+            [0.0, 0.0, 0.0],
+            [0.0, 1.0],
+            -1.0,
+            0.15,
+            params,
+        )
     }
 
     #[test]
