@@ -95,6 +95,12 @@ pub struct BendParams {
     /// virtual profile, so that a ramp (behind a curb cut) is not taken for a step. Not in
     /// the paper; 10 % is above road cross slopes and sidewalk falls.
     pub profile_max_slope: f64,
+    /// Steepest fall of a virtual profile's road part towards the toe (the road lower
+    /// beside the toe than away from it). Not in the paper: a gutter channel falls to the
+    /// toe more steeply than the road, and across a side street's curb the main road's
+    /// grade adds to that fall; 15 % takes an 8 % gutter on a 6 % grade. A road part rising
+    /// to the toe keeps `profile_max_slope`.
+    pub profile_max_road_fall: f64,
     /// How far from the trajectory, metres, each interval's sides are searched for a curb
     /// toe on virtual profiles across the driving direction, which seed tracks besides the
     /// core's candidates (`seed::profile_seeds`; 0 = never). Not in the paper: where a scanline
@@ -222,6 +228,7 @@ impl Default for BendParams {
             profile_half_length_m: 0.15,
             profile_min_step_m: 0.05,
             profile_max_slope: 0.1,
+            profile_max_road_fall: 0.15,
             profile_seed_reach_m: 15.0,
             cut_follow_max_m: 15.0,
             weak_rho_deg: 30.0,

@@ -40,7 +40,7 @@ pub struct ProfileToe {
 /// by a line, and the toe is accepted only as a curb: a step of at least
 /// `profile_min_step_m` (and under the search half-height) between the two lines at the
 /// toe, both parts ground-like (slopes under `profile_max_slope`, so a curb cut's ramp is
-/// no step), the lines' RMS under a quarter of the step, ground within 0.15 m on both
+/// no step; a road part falling to the toe under `profile_max_road_fall`), the lines' RMS under a quarter of the step, ground within 0.15 m on both
 /// sides of the toe, and the toe within `profile_half_width_m` − 0.15 m of the centre.
 pub fn profile_toe(
     input: &BendInput,
@@ -203,9 +203,10 @@ fn profile_split(
     let (ha, hb, he) = line(hi, m);
     let step = (ha + hb * toe) - (la + lb * toe);
     let rms = ((le + he) / (lo + m - hi) as f64).sqrt();
-    // Both parts must be ground, not a ramp or a car's flank.
+    // Both parts must be ground, not a ramp or a car's flank; the road may fall to the
+    // toe more steeply (a gutter, a grade across a side street's curb).
     let max_slope = params.profile_max_slope;
-    if lb.abs() > max_slope || hb.abs() > max_slope {
+    if lb > max_slope || -lb > params.profile_max_road_fall || hb.abs() > max_slope {
         return None;
     }
     if step < params.profile_min_step_m || step > params.search_half_height_m {
@@ -469,6 +470,67 @@ pub fn cut_toe(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::trajectory::Trajectory;
+
+    /// The toe on a profile across a curb along y at x = 0 (0.15 m up towards +x, the
+    /// sidewalk rising 2 % away from it), points every 2 cm across and 5 cm along, the road
+    /// at `road(x)` for x < 0.
+    fn toe_beside(road: impl Fn(f64) -> f64, params: &BendParams) -> Option<ProfileToe> {
+        let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..45 {
+            for j in 0..13 {
+                let px = -0.45 + 0.02 * f64::from(i) + 0.01;
+                x.push(px);
+                y.push(-0.3 + 0.05 * f64::from(j));
+                z.push(if px < 0.0 { road(px) } else { 0.15 + 0.02 * px });
+            }
+        }
+        let n = x.len();
+        let (t, rho) = (vec![0.0; n], vec![0.0f32; n]);
+        let status = vec![Some(PointStatus::Kept); n];
+        let scanline = vec![0u32; n];
+        let trajectory = Trajectory::default();
+        let input = BendInput {
+            x: &x,
+            y: &y,
+            z: &z,
+            t: &t,
+            rho_deg: &rho,
+            status: &status,
+            scanline: &scanline,
+            candidates: &[],
+            trajectory: &trajectory,
+        };
+        let grid = PointGrid::build(&x, &y, 0.1, |_| true);
+        // Walking along +y with the curb on the right (+x).
+        profile_toe(
+            &input,
+            &grid,
+            [0.0, 0.0, 0.0],
+            [0.0, 1.0],
+            -1.0,
+            0.15,
+            params,
+        )
+    }
+
+    #[test]
+    fn a_road_falling_steeply_to_the_toe_still_shows_it_and_a_rising_one_does_not() {
+        let params = BendParams::default();
+        // A gutter on a grade: the road falls 12 % to the toe.
+        let toe = toe_beside(|x| -0.12 * x, &params).expect("a toe beside a 12 % fall");
+        assert!(toe.xyz[0].abs() < 0.03, "{toe:?}");
+        assert!((toe.step_m - 0.15).abs() < 0.02, "{toe:?}");
+        // The same ground with the fall held to the rising limit: no toe.
+        let strict = BendParams {
+            profile_max_road_fall: params.profile_max_slope,
+            ..BendParams::default()
+        };
+        assert!(toe_beside(|x| -0.12 * x, &strict).is_none());
+        // A road rising 12 % to the toe, or falling 20 %, is no curb's road.
+        assert!(toe_beside(|x| 0.12 * x + 0.05, &params).is_none());
+        assert!(toe_beside(|x| -0.2 * x, &params).is_none());
+    }
 
     #[test]
     fn sort_across_is_the_stable_sort_by_total_cmp() {
