@@ -457,11 +457,18 @@ impl SceneSpec {
     /// extent of the mouth including the corners.
     pub fn mouth(&self, x: &Intersection) -> (f64, f64) {
         let sn = x.angle_deg.to_radians().sin();
+        let reach = x.width / 2.0 / sn + self.corner_reach(x) + 1.0;
+        (x.u - reach, x.u + reach)
+    }
+
+    /// How far the corners of side street `x` reach from where its curb lines meet the
+    /// main curb line, metres (a bound, the same on both corners).
+    pub fn corner_reach(&self, x: &Intersection) -> f64 {
+        let sn = x.angle_deg.to_radians().sin();
         let cot = x.angle_deg.to_radians().cos() / sn;
         // The flared part turns at most 20° on its larger radius before the corner proper.
         let flare = (x.flare - 1.0).max(0.0) * x.radius * 20f64.to_radians().sin();
-        let reach = x.width / 2.0 / sn + (x.radius + flare) * (1.0 + cot.abs()) + 1.0;
-        (x.u - reach, x.u + reach)
+        (x.radius + flare) * (1.0 + cot.abs())
     }
 }
 

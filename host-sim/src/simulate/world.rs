@@ -237,7 +237,10 @@ impl World {
                     for k in [-(x.width / 2.0 + sw + 0.15), x.width / 2.0 + sw + 0.15] {
                         let base = [x.u + k * sn, w - k * cs];
                         let at = |t: f64| center.map(base[0] + cs * t, sgn * (base[1] + sn * t));
-                        let mut t0 = (w + sw - base[1]) / sn;
+                        // Behind the corners: on an acute corner the line through the
+                        // main sidewalk's back edge would cross the corner arc.
+                        let e0 = w + sw + spec.corner_reach(x) * sn;
+                        let mut t0 = (e0 - base[1]) / sn;
                         let t_end = (w + x.length - base[1]) / sn;
                         while t0 < t_end {
                             let t1 = t0 + 2.0;
@@ -525,6 +528,37 @@ mod tests {
         let o = [c[0] - 1.0, c[1], 0.5 * (z[0] + z[1])];
         let h = w.objects.intersect(o, [1.0, 0.0, 0.0], 0.0, 2.0).unwrap();
         assert!(h.t <= 1.0 - r + 1e-9 && h.material == Material::Vegetation);
+    }
+
+    #[test]
+    fn walls_along_an_acute_side_street_stand_behind_its_corner_arcs() {
+        let mut s = tiny();
+        s.intersections = vec![crate::simulate::scene::Intersection {
+            side: Side::Left,
+            u: 20.0,
+            width: 8.0,
+            radius: 10.0,
+            length: 30.0,
+            angle_deg: 60.0,
+            flare: 1.0,
+        }];
+        let w = World::build(s, 1);
+        let toe_pts: Vec<[f64; 2]> = w.ground.toes.iter().flat_map(|t| t.pts.clone()).collect();
+        let mut walls = 0;
+        for p in &w.objects.prims {
+            if let (Shape::Box { c, .. }, Material::Wall) = (&p.shape, p.material) {
+                walls += 1;
+                let near = toe_pts
+                    .iter()
+                    .map(|q| (q[0] - c[0]).hypot(q[1] - c[1]))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(
+                    near > 1.0,
+                    "a wall piece at {c:?} stands {near:.2} m from a toe"
+                );
+            }
+        }
+        assert!(walls > 0);
     }
 
     #[test]
