@@ -167,6 +167,9 @@ pub struct StageCpu {
 pub struct StageTimes {
     /// Reading the point file (decode, select, sort).
     pub read_s: f64,
+    /// Of a stream: the reader's wait for room in its queue to the core stage (the
+    /// stages after it were behind), not part of `read_s`.
+    pub read_wait_s: f64,
     /// Reading the trajectory and the coverage check.
     pub trajectory_s: f64,
     /// Projection, encoding and the core.
@@ -226,7 +229,7 @@ impl Summary {
              scanlines          {lines}{arcs}\n\
              candidates         {cand}\n\
              edges              {edges}, total length {len:.1} m\n\
-             time               {total:.2} s ({pts:.2} M points/s): read {r:.2} s, trajectory {t:.2} s, core {k:.2} s, edges {e:.2} s\n\
+             time               {total:.2} s ({pts:.2} M points/s): read {r:.2} s{rw}, trajectory {t:.2} s, core {k:.2} s, edges {e:.2} s\n\
              cpu                {ctot:.2} s: read {cr:.2} s, core {ck:.2} s, edges {ce:.2} s\n\
              peak memory        {mem}",
             read = self.points_read(),
@@ -253,6 +256,11 @@ impl Summary {
             total = self.times.total_s,
             pts = pts_per_s / 1e6,
             r = self.times.read_s,
+            rw = if self.times.read_wait_s > 0.0 {
+                format!(" (then {:.2} s waiting for the core)", self.times.read_wait_s)
+            } else {
+                String::new()
+            },
             t = self.times.trajectory_s,
             k = self.times.core_s,
             e = self.times.edges_s,

@@ -256,11 +256,28 @@ fn gather(
     half_l: f64,
     params: &BendParams,
 ) -> Vec<(f64, f64, f64)> {
-    let mut prof: Vec<(f64, f64, f64)> = Vec::new();
-    for_each_on_profile(input, grid, centre, along, up, half_l, params, |i, c, a| {
-        prof.push((c, input.z[i], a))
-    });
-    sort_across(prof)
+    SCRATCH.with_borrow_mut(|s| {
+        s.prof.clear();
+        for_each_on_profile(input, grid, centre, along, up, half_l, params, |i, c, a| {
+            s.prof.push((c, input.z[i], a))
+        });
+        sort_across(&s.prof, &mut s.keys, &mut s.starts)
+    })
+}
+
+/// A thread's buffers for [`gather`]: the points as the grid hands them over and the sort's
+/// keys and buckets, kept from one profile to the next (a section gathers thousands of
+/// profiles of a few thousand points each; growing fresh vectors for each cost more than
+/// sorting them).
+#[derive(Default)]
+struct Scratch {
+    prof: Vec<(f64, f64, f64)>,
+    keys: Vec<(u64, u64, u32)>,
+    starts: Vec<u32>,
+}
+
+std::thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
 }
 
 /// Calls `f(i, across, along)` for every usable point `i` of a virtual profile (see
@@ -298,10 +315,18 @@ pub(super) fn for_each_on_profile(
 }
 
 /// `prof` sorted by `across`, then height, by `total_cmp`, points equal in both kept in
-/// the order they came in: the order of a stable sort, found by an unstable sort of
-/// integer keys (each float's bits mapped so that unsigned order is `total_cmp`'s, then
-/// the point's place), which is cheaper than comparing the floats.
-fn sort_across(prof: Vec<(f64, f64, f64)>) -> Vec<(f64, f64, f64)> {
+/// the order they came in: the order of a stable sort. Each point gets integer keys (each
+/// float's bits mapped so that unsigned order is `total_cmp`'s, then the point's place),
+/// which compare cheaper than the floats. Where the offsets across span a finite range,
+/// the points are first dealt into about one bucket a point by their offset (a counting
+/// sort, stable; the bucket is a non-decreasing function of the offset, so no two points
+/// are out of order across buckets) and each bucket is then sorted by its keys, a few
+/// points at a time; otherwise the keys are sorted at once.
+fn sort_across(
+    prof: &[(f64, f64, f64)],
+    keys: &mut Vec<(u64, u64, u32)>,
+    starts: &mut Vec<u32>,
+) -> Vec<(f64, f64, f64)> {
     let ordered = |v: f64| {
         let b = v.to_bits();
         if b >> 63 == 1 {
@@ -310,12 +335,48 @@ fn sort_across(prof: Vec<(f64, f64, f64)>) -> Vec<(f64, f64, f64)> {
             b | 1 << 63
         }
     };
-    let mut keys: Vec<(u64, u64, u32)> = prof
+    let key = |k: usize, p: &(f64, f64, f64)| (ordered(p.0), ordered(p.1), k as u32);
+    let n = prof.len();
+    let (lo, hi) = prof
         .iter()
-        .enumerate()
-        .map(|(k, p)| (ordered(p.0), ordered(p.1), k as u32))
-        .collect();
-    keys.sort_unstable();
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.0), hi.max(p.0))
+        });
+    let span = hi - lo;
+    keys.clear();
+    if n < 16 || !(span.is_finite() && span > 0.0) || prof.iter().any(|p| p.0.is_nan()) {
+        keys.extend(prof.iter().enumerate().map(|(k, p)| key(k, p)));
+        keys.sort_unstable();
+        return keys.iter().map(|k| prof[k.2 as usize]).collect();
+    }
+    // Bucket of an offset: (c − lo) · scale, rounded down; each step is non-decreasing in c.
+    let buckets = n;
+    let scale = (buckets - 1) as f64 / span;
+    let bucket = |c: f64| (((c - lo) * scale) as usize).min(buckets - 1);
+    // `starts[b + 1]` counts bucket b, then (prefix sums) is where bucket b + 1 begins; the
+    // deal moves each bucket's start on to its end, so `starts[b]` is then bucket b's end.
+    starts.clear();
+    starts.resize(buckets + 1, 0);
+    for p in prof {
+        starts[bucket(p.0) + 1] += 1;
+    }
+    for b in 0..buckets {
+        starts[b + 1] += starts[b];
+    }
+    keys.resize(n, (0, 0, 0));
+    for (k, p) in prof.iter().enumerate() {
+        let b = bucket(p.0);
+        keys[starts[b] as usize] = key(k, p);
+        starts[b] += 1;
+    }
+    let mut s = 0;
+    for &e in &starts[..buckets] {
+        let e = e as usize;
+        if e - s > 1 {
+            keys[s..e].sort_unstable();
+        }
+        s = e;
+    }
     keys.iter().map(|k| prof[k.2 as usize]).collect()
 }
 
@@ -328,13 +389,16 @@ struct Sums {
 impl Sums {
     fn new(prof: &[(f64, f64, f64)]) -> Self {
         let z0 = prof.first().map_or(0.0, |p| p.1);
-        let mut acc = vec![[0.0f64; 6]; prof.len() + 1];
-        for (k, p) in prof.iter().enumerate() {
+        let mut acc = Vec::with_capacity(prof.len() + 1);
+        let mut run = [0.0f64; 6];
+        acc.push(run);
+        for p in prof {
             let (c, z) = (p.0, p.1 - z0);
             let t = [1.0, c, c * c, z, c * z, z * z];
             for j in 0..6 {
-                acc[k + 1][j] = acc[k][j] + t[j];
+                run[j] += t[j];
             }
+            acc.push(run);
         }
         Self { acc }
     }
@@ -532,30 +596,69 @@ mod tests {
         assert!(toe_beside(|x| -0.2 * x, &params).is_none());
     }
 
-    #[test]
-    fn sort_across_is_the_stable_sort_by_total_cmp() {
-        // Positions and heights on a coarse lattice (many exact ties, ±0, a NaN), the third
-        // value telling the points apart: ties must keep their order of arrival.
-        let mut prof = Vec::new();
-        for k in 0..2_000u32 {
-            let c = f64::from(k.wrapping_mul(2_654_435_761) % 41) * 0.025 - 0.5;
-            let z = f64::from(k.wrapping_mul(40_503) % 7) * 0.01 - 0.03;
-            prof.push((c, z, f64::from(k)));
-        }
-        prof.push((-0.0, 0.0, -1.0));
-        prof.push((0.0, -0.0, -2.0));
-        prof.push((f64::NAN, 0.0, -3.0));
-        prof.push((-1e-300, f64::INFINITY, -4.0));
+    /// `sort_across(prof)` against the standard library's stable sort by `total_cmp`, bit
+    /// for bit; asserts the profile had exact ties (kept in arrival order).
+    fn assert_stable_sorted(prof: Vec<(f64, f64, f64)>) {
         let mut want = prof.clone();
         want.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.total_cmp(&q.1)));
-        let got = sort_across(prof);
+        let got = sort_across(&prof, &mut Vec::new(), &mut Vec::new());
         let bits = |v: &[(f64, f64, f64)]| -> Vec<[u64; 3]> {
             v.iter()
                 .map(|p| [p.0.to_bits(), p.1.to_bits(), p.2.to_bits()])
                 .collect()
         };
         assert_eq!(bits(&got), bits(&want));
-        // Ties there were, and they are in arrival order.
         assert!(got.windows(2).any(|w| w[0].0 == w[1].0 && w[0].1 == w[1].1));
+    }
+
+    /// Positions and heights on a coarse lattice (many exact ties), the third value
+    /// telling the points apart.
+    fn lattice(n: u32) -> Vec<(f64, f64, f64)> {
+        (0..n)
+            .map(|k| {
+                let c = f64::from(k.wrapping_mul(2_654_435_761) % 41) * 0.025 - 0.5;
+                let z = f64::from(k.wrapping_mul(40_503) % 7) * 0.01 - 0.03;
+                (c, z, f64::from(k))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn sort_across_is_the_stable_sort_by_total_cmp() {
+        // With a NaN across (no finite span: the keys sorted at once).
+        let mut prof = lattice(2_000);
+        prof.push((-0.0, 0.0, -1.0));
+        prof.push((0.0, -0.0, -2.0));
+        prof.push((f64::NAN, 0.0, -3.0));
+        prof.push((-1e-300, f64::INFINITY, -4.0));
+        assert_stable_sorted(prof);
+    }
+
+    #[test]
+    fn sort_across_by_buckets_is_the_stable_sort_by_total_cmp() {
+        // Finite offsets (dealt into buckets): ±0 and a tiny negative offset share a
+        // bucket, offsets a few ulp apart and the span's ends too.
+        let mut prof = lattice(2_000);
+        prof.push((-0.0, 0.0, -1.0));
+        prof.push((0.0, -0.0, -2.0));
+        prof.push((-1e-300, f64::INFINITY, -4.0));
+        prof.push((0.5, 0.0, -5.0));
+        prof.push((f64::from_bits(0.5f64.to_bits() - 1), 0.0, -6.0));
+        prof.push((-0.5, 0.0, -7.0));
+        prof.push((f64::from_bits(0.3f64.to_bits() + 2), 1.0, -8.0));
+        prof.push((0.3, 1.0, -9.0));
+        assert_stable_sorted(prof.clone());
+        // Few points: each bucket holds one or two.
+        assert_stable_sorted(
+            (0..40u32)
+                .map(|k| (f64::from(k * 7 % 5) * 0.1, f64::from(k % 2), f64::from(k)))
+                .collect(),
+        );
+        // One offset only (a zero span): the keys sorted at once.
+        assert_stable_sorted(
+            (0..50)
+                .map(|k| (0.1, f64::from(k % 3), f64::from(k)))
+                .collect(),
+        );
     }
 }

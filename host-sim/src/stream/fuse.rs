@@ -60,6 +60,7 @@ pub fn add_summaries(mut a: ExtractResult, b: &ExtractResult) -> ExtractResult {
     s.candidates += o.candidates;
     let (t, u) = (&mut s.times, &o.times);
     t.read_s += u.read_s;
+    t.read_wait_s += u.read_wait_s;
     t.trajectory_s += u.trajectory_s;
     t.core_s += u.core_s;
     t.edges_s += u.edges_s;

@@ -7,8 +7,9 @@
 //! with their channel key     last line carried on                  vehicle passes them   boundaries
 //! ```
 //!
-//! The stages are joined by bounded channels (one batch in flight each way), so decoding
-//! runs beside the core and the tracker, and memory holds a few batches and one window:
+//! The stages are joined by bounded channels (a few batches from the reader, one from the
+//! core stage), so decoding runs beside the core and the tracker, and memory holds a few
+//! batches and one window:
 //! it does not grow with the input. Inputs not in time order are detected by the source
 //! and the run starts again on a chunk-wise external sort (see `source::external_sort`).
 //!
@@ -51,6 +52,13 @@ pub use window::WindowParams;
 
 /// Points per batch the reader hands to the core stage.
 pub const STREAM_BATCH_POINTS: usize = BATCH_POINTS;
+
+/// Batches the reader may decode ahead of the core stage (about 1.3 MB each). The window
+/// runs a section at a time, and the parts of a section that run on one thread hold up
+/// the core stage and, through it, the reader: with a single batch in flight the decoder
+/// stood idle for most of each section, with a few it keeps decoding
+/// (docs/benchmarks.md).
+const READ_AHEAD_BATCHES: usize = 4;
 
 /// What one pass over a source produced.
 struct Pass {
@@ -588,17 +596,19 @@ fn run_pass(
     let cpu0 = process_cpu_s();
     let bytes_done = AtomicU64::new(0);
     let read_s = AtomicU64::new(0);
+    let read_wait_s = AtomicU64::new(0);
     let core_s = AtomicU64::new(0);
     let read_thread_cpu = AtomicU64::new(0);
     std::thread::scope(|s| {
-        let (tx_b, rx_b) = sync_channel::<Result<PointBatch, SourceError>>(1);
+        let (tx_b, rx_b) = sync_channel::<Result<PointBatch, SourceError>>(READ_AHEAD_BATCHES);
         let (tx_c, rx_c) = sync_channel::<Result<core_stage::CoreBatch, PassError>>(1);
         let bytes_done = &bytes_done;
         let (read_s, core_s, read_thread_cpu) = (&read_s, &core_s, &read_thread_cpu);
+        let read_wait_s = &read_wait_s;
         let reader = std::thread::Builder::new()
             .name(READ_THREADS.into())
             .spawn_scoped(s, move || {
-                let mut busy = 0.0;
+                let (mut busy, mut waiting) = (0.0, 0.0);
                 let mut source = match spec.open() {
                     Ok(s) => s,
                     Err(e) => {
@@ -617,11 +627,15 @@ fn run_pass(
                         Ok(None) => break,
                         Err(e) => Err(e),
                     };
-                    if tx_b.send(msg).is_err() || stop {
+                    let t0 = Instant::now();
+                    let sent = tx_b.send(msg);
+                    waiting += t0.elapsed().as_secs_f64();
+                    if sent.is_err() || stop {
                         break;
                     }
                 }
                 read_s.store(busy.to_bits(), Ordering::Relaxed);
+                read_wait_s.store(waiting.to_bits(), Ordering::Relaxed);
                 read_thread_cpu.store(thread_cpu_s().to_bits(), Ordering::Relaxed);
                 source.selection()
             })
@@ -727,6 +741,7 @@ fn run_pass(
         let total_cpu = process_cpu_s() - cpu0;
         let times = StageTimes {
             read_s: f64::from_bits(read_s.load(Ordering::Relaxed)),
+            read_wait_s: f64::from_bits(read_wait_s.load(Ordering::Relaxed)),
             core_s: f64::from_bits(core_s.load(Ordering::Relaxed)),
             edges_s,
             cpu: StageCpu {
