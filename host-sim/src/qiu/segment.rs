@@ -597,7 +597,7 @@ mod tests {
         }));
         let smallest: Vec<usize> = curb.iter().chain(&lip).chain(&noise).copied().collect();
         // The noisy set has the smallest energy: it is still not chosen.
-        let sets = vec![
+        let sets = [
             (0.001, 0.01, smallest),
             (0.002, 0.02, curb.clone()),
             (0.002, 0.04, curb.clone()),
