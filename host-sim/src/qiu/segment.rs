@@ -260,9 +260,10 @@ pub struct Segmentation {
 /// smallest E_s, or whose √E_s is within `energy_slack_m` of the smallest √E_s, wins (with
 /// both 0, the set with the smallest E_s as in the paper; ties go to the smaller β, which
 /// sees lower curbs). `low_beta` = [corridor, window] (metres; corridor 0: off): the
-/// smaller βs' candidates (within the noise excepted) join the chosen set where their
-/// offset is within the corridor of the median of the chosen set's innermost offsets
-/// within the window along the trajectory — a curb cut's low lip beside a curb.
+/// smaller βs' candidates (those within the noise too, in a narrower corridor: see
+/// `SetChoice::choose`) join the chosen set where their offset is within the corridor of
+/// the median of the chosen set's innermost offsets within the window along the
+/// trajectory — a curb cut's low lip beside a curb.
 #[allow(clippy::too_many_arguments)]
 pub fn rough_segmentation(
     pts: &[[f64; 3]],
@@ -326,52 +327,91 @@ pub fn rough_segmentation(
     }
     let mut in_set = vec![false; pts.len()];
     for (side, mut sets) in sets.into_iter().enumerate() {
-        // The smallest βs lie within the noise while their candidate count is more than
-        // `noise_count_ratio` times the next larger β's: noise outliers fill the road, an
-        // edge's candidates thin out slowly with β.
         sets.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let choice = SetChoice {
+            energy_tolerance,
+            energy_slack_m,
+            noise_count_ratio,
+            low_beta,
+        };
+        if let Some((beta, chosen)) = choice.choose(&sets, &mut in_set, position_of) {
+            out.beta_m[side] = Some(beta);
+            out.candidates.extend(chosen);
+        }
+    }
+    out.candidates.sort_unstable();
+    out
+}
+
+/// The corridor's half width for the candidates of βs within the noise, metres: a cut's lip
+/// lies on the curb's toe line (within the 0.1 m neighbour radius), while the road's noise
+/// and a lipless ramp's rise fill the whole corridor.
+const NOISY_CORRIDOR_M: f64 = 0.1;
+
+/// How one side's candidate set is chosen among the refined planes' sets (see
+/// [`rough_segmentation`]).
+struct SetChoice {
+    energy_tolerance: f64,
+    energy_slack_m: f64,
+    noise_count_ratio: f64,
+    low_beta: [f64; 2],
+}
+
+impl SetChoice {
+    /// Of one side's sets (E_s, β, candidates), in β order: the chosen β and its candidates
+    /// with the smaller βs' candidates along its innermost line, marked in `in_set`.
+    ///
+    /// The smallest βs lie within the noise while their candidate count is more than
+    /// `noise_count_ratio` times the next larger β's (noise outliers fill the road, an edge's
+    /// candidates thin out slowly with β): they are never chosen. They still feed the
+    /// corridor along the chosen line, narrowed to [`NOISY_CORRIDOR_M`]: a curb cut's low
+    /// lip is often an outlier of the smallest β only, and that close to the line its
+    /// candidates outnumber the road's noise.
+    fn choose(
+        &self,
+        sets: &[(f64, f64, Vec<usize>)],
+        in_set: &mut [bool],
+        position_of: &dyn Fn(usize) -> Option<(f64, f64)>,
+    ) -> Option<(f64, Vec<usize>)> {
         let noisy = sets
             .windows(2)
-            .take_while(|w| w[0].2.len() as f64 > noise_count_ratio * w[1].2.len() as f64)
+            .take_while(|w| w[0].2.len() as f64 > self.noise_count_ratio * w[1].2.len() as f64)
             .count();
-        sets.drain(..noisy);
-        let Some(e_min) = sets.iter().map(|s| s.0).min_by(f64::total_cmp) else {
-            continue;
-        };
-        let limit = (e_min * (1.0 + energy_tolerance)).max((e_min.sqrt() + energy_slack_m).powi(2));
-        let Some(k) = (0..sets.len())
+        let e_min = sets[noisy..].iter().map(|s| s.0).min_by(f64::total_cmp)?;
+        let limit = (e_min * (1.0 + self.energy_tolerance))
+            .max((e_min.sqrt() + self.energy_slack_m).powi(2));
+        let k = (noisy..sets.len())
             .filter(|&k| sets[k].0 <= limit)
-            .min_by(|&a, &b| sets[a].1.total_cmp(&sets[b].1))
-        else {
-            continue;
-        };
-        let beta = sets[k].1;
-        out.beta_m[side] = Some(beta);
-        for &i in &sets[k].2 {
+            .min_by(|&a, &b| sets[a].1.total_cmp(&sets[b].1))?;
+        let mut chosen = sets[k].2.clone();
+        for &i in &chosen {
             in_set[i] = true;
         }
-        out.candidates.extend(sets[k].2.iter().copied());
         // The smaller βs' candidates along the chosen set's innermost line.
-        let [corridor, window] = low_beta;
+        let [corridor, window] = self.low_beta;
         if corridor > 0.0 && k > 0 {
             let line = innermost_line(&sets[k].2, position_of);
-            for set in &sets[..k] {
+            for (j, set) in sets[..k].iter().enumerate() {
+                let reach = if j < noisy {
+                    corridor.min(NOISY_CORRIDOR_M)
+                } else {
+                    corridor
+                };
                 for &i in &set.2 {
                     if in_set[i] {
                         continue;
                     }
                     if position_of(i)
-                        .is_some_and(|(s, d)| along_line(&line, s, d.abs(), corridor, window))
+                        .is_some_and(|(s, d)| along_line(&line, s, d.abs(), reach, window))
                     {
                         in_set[i] = true;
-                        out.candidates.push(i);
+                        chosen.push(i);
                     }
                 }
             }
         }
+        Some((sets[k].1, chosen))
     }
-    out.candidates.sort_unstable();
-    out
 }
 
 /// Whether a point at station `s` and offset `d` (absolute) lies within `corridor` of
@@ -522,6 +562,60 @@ mod tests {
         assert!(!along_line(&line, 70.0, 5.0, 0.3, 20.0));
         // A window shorter than the cut finds no line in its middle.
         assert!(!along_line(&line, 20.0, 5.05, 0.3, 5.0));
+    }
+
+    #[test]
+    fn a_cuts_lip_seen_by_the_noisy_beta_only_joins_the_chosen_line() {
+        // Stations and offsets: a curb at 5 m every 0.5 m with a cut from 15 to 25 m whose
+        // lip (5.02 m) only the smallest β sees, and road noise at 1–4 m that also only the
+        // smallest β sees, more than the curb.
+        let mut pos: Vec<(f64, f64)> = Vec::new();
+        let curb: Vec<usize> = (0..80)
+            .map(|k| k as f64 * 0.5)
+            .filter(|s| !(15.0..25.0).contains(s))
+            .map(|s| {
+                pos.push((s, 5.0));
+                pos.len() - 1
+            })
+            .collect();
+        let lip: Vec<usize> = (0..40)
+            .map(|k| {
+                pos.push((15.0 + k as f64 * 0.25, 5.02));
+                pos.len() - 1
+            })
+            .collect();
+        let mut noise: Vec<usize> = (0..240)
+            .map(|k| {
+                pos.push(((k % 80) as f64 * 0.5, 1.0 + (k / 80) as f64 * 1.5));
+                pos.len() - 1
+            })
+            .collect();
+        // A ramp's rise 0.25 m behind the cut's toe: within the corridor, beyond the lip.
+        noise.extend((0..40).map(|k| {
+            pos.push((15.0 + k as f64 * 0.25, 5.25));
+            pos.len() - 1
+        }));
+        let smallest: Vec<usize> = curb.iter().chain(&lip).chain(&noise).copied().collect();
+        // The noisy set has the smallest energy: it is still not chosen.
+        let sets = [
+            (0.001, 0.01, smallest),
+            (0.002, 0.02, curb.clone()),
+            (0.002, 0.04, curb.clone()),
+        ];
+        let choice = SetChoice {
+            energy_tolerance: 0.0,
+            energy_slack_m: 0.01,
+            noise_count_ratio: 1.5,
+            low_beta: [0.3, 20.0],
+        };
+        let mut in_set = vec![false; pos.len()];
+        let (beta, chosen) = choice
+            .choose(&sets, &mut in_set, &|i| Some(pos[i]))
+            .unwrap();
+        assert_eq!(beta, 0.02);
+        assert!(curb.iter().chain(&lip).all(|i| chosen.contains(i)));
+        assert!(noise.iter().all(|i| !chosen.contains(i)));
+        assert_eq!(chosen.len(), curb.len() + lip.len());
     }
 
     #[test]
