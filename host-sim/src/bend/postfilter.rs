@@ -153,12 +153,14 @@ const GAP_SHARE: f64 = 0.3;
 /// the disc on one side holds no point while the disc on the other side holds some, their
 /// median height does not rise above the vertex by half a curb step, neither do the
 /// points between the vertex and the empty disc, and the first returns past the empty disc
-/// (within [`GAP_LOOK_M`]) lie at the vertex's height, or there are none. A curb toe has returns on both sides (the
-/// road before it, the curb's top behind it); where the curb hides the road behind it in
-/// its shadow, the seen side is the curb top, which rises; where the vehicle's body hides
-/// the curb's top, the face rises between the toe and the gap, or the top shows past it. What is left is the border
-/// of an area the scanner never reached (the vehicle's own body in the way, a dropout),
-/// where the scanlines end on flat ground.
+/// (within [`GAP_LOOK_M`]) lie at the vertex's height, or there are none.
+///
+/// A curb toe has returns on both sides (the road before it, the curb's top behind it);
+/// where the curb hides the road behind it in its shadow, the seen side is the curb top,
+/// which rises; where the vehicle's body hides the curb's top, the face rises between the
+/// toe and the gap, or the top shows past it. What is left is the border of an area the
+/// scanner never reached (the vehicle's own body in the way, a dropout), where the
+/// scanlines end on flat ground.
 fn at_return_gap(
     input: &BendInput,
     grid: &PointGrid,
