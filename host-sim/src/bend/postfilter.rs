@@ -175,7 +175,7 @@ fn at_return_gap(
     );
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let len = dx.hypot(dy);
-    if !(len > 1e-6) {
+    if len.is_nan() || len <= 1e-6 {
         return false;
     }
     let n = [-dy / len, dx / len];
