@@ -81,9 +81,9 @@ impl<'a> BendInput<'a> {
 }
 
 /// Extracts the road edges (Honma et al. §2.6–2.7): seeds by RANSAC per interval, tracks
-/// from every seed in both directions, removes short edges, edges under vehicles and edges
-/// outside the roadway, and returns each edge once with `method = "bend"`, its side, its
-/// median height step and a category per stretch.
+/// from every seed in both directions, removes short edges, edges under vehicles, edges
+/// along gaps in the returns and edges outside the roadway, and returns each edge once
+/// with `method = "bend"`, its side, its median height step and a category per stretch.
 pub fn extract_edges(input: &BendInput, params: &BendParams) -> Vec<EdgeLine> {
     extract_edges_with_steps(input, params)
         .into_iter()
@@ -177,6 +177,7 @@ pub fn extract_edges_on_grid(
     shadow::place_shadowed_toes(&input, grid, &mut tracks, params);
     let tracks = postfilter::remove_short(&input, tracks, params);
     let tracks = postfilter::remove_under_objects(&input, grid, tracks, params);
+    let tracks = postfilter::remove_at_return_gaps(&input, grid, tracks, params);
     let tracks = if params.roadway_filter {
         postfilter::remove_outside_roadway(&input, route, tracks)
     } else {

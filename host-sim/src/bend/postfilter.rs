@@ -3,6 +3,9 @@
 //! 1. Short edges are removed.
 //! 2. Edges with points in a height band above them are removed: they run along the foot
 //!    of a vehicle (or another object standing on the road), not along a curb.
+//!    Then edges along the border of a gap in the returns (the ground beside them on one
+//!    side unseen, on the other flat) are removed: the scanlines end there, at the
+//!    vehicle's own body or a dropout, not at a curb ([`remove_at_return_gaps`]).
 //! 3. Edges outside the roadway are removed: if the segment from an end of an edge to its
 //!    nearest trajectory point crosses another edge of the same side, the edge lies behind
 //!    that other edge (e.g. the foot of a wall behind the curb).
@@ -91,31 +94,160 @@ pub fn remove_under_objects(
             .iter()
             .map(|&q| covered(input, grid, q, params))
             .collect();
-        let n = cov.len();
-        let share = cov.iter().filter(|&&c| c).count() as f64 / n.max(1) as f64;
-        if share < params.vehicle_share {
-            out.push(t);
+        keep_unflagged(input, t, &cov, params.vehicle_share, &mut out);
+    }
+    out
+}
+
+/// Pushes `t` onto `out` whole when under `share` of its vertices are flagged, and
+/// otherwise its unflagged stretches of at least [`UNCOVERED_KEEP_M`] as tracks of their
+/// own.
+fn keep_unflagged(input: &BendInput, t: Track, flags: &[bool], share: f64, out: &mut Vec<Track>) {
+    let n = flags.len();
+    let flagged = flags.iter().filter(|&&c| c).count() as f64 / n.max(1) as f64;
+    if flagged < share {
+        out.push(t);
+        return;
+    }
+    let mut k = 0;
+    while k < n {
+        if flags[k] {
+            k += 1;
             continue;
         }
-        let mut k = 0;
-        while k < n {
-            if cov[k] {
-                k += 1;
-                continue;
+        let start = k;
+        while k < n && !flags[k] {
+            k += 1;
+        }
+        let piece = Track {
+            points: t.points[start..k].to_vec(),
+            xyz: t.xyz[start..k].to_vec(),
+            side: t.side,
+        };
+        if track_length_m(input, &piece) >= UNCOVERED_KEEP_M {
+            out.push(piece);
+        }
+    }
+}
+
+/// Distance across the track from a vertex to the centres of the two discs that
+/// [`at_return_gap`] looks into, metres: past the curb's face and batter, within a curb
+/// top's width.
+const GAP_SIDE_OFFSET_M: f64 = 0.3;
+/// Radius of those discs, metres: at the far side's sparsest lines and point spacing
+/// (0.15 m each way) a disc this size on returned ground holds a few points.
+const GAP_SIDE_RADIUS_M: f64 = 0.15;
+/// How far across the track, metres, the first returns past an empty disc are looked for:
+/// the body's gap before a near curb hides its face and top over a metre or so, while the
+/// border of a gap wider than this has nothing but its own flat ground to show.
+const GAP_LOOK_M: f64 = 1.5;
+/// Fewest points in the disc on the seen side for the other, empty side to count as a gap
+/// in the returns rather than a place the scanner barely reached.
+const GAP_SEEN_MIN_POINTS: usize = 3;
+/// Vertices on each side of a vertex whose chord gives the track's direction there.
+const GAP_TANGENT_VERTICES: usize = 3;
+/// Share of a track's vertices at a gap in the returns from which filter 2b cuts them out.
+const GAP_SHARE: f64 = 0.3;
+
+/// Whether vertex `k` of `t` lies at the edge of a gap in the returns: across the track,
+/// the disc on one side holds no point while the disc on the other side holds some, their
+/// median height does not rise above the vertex by half a curb step, neither do the
+/// points between the vertex and the empty disc, and the first returns past the empty disc
+/// (within [`GAP_LOOK_M`]) lie at the vertex's height, or there are none.
+///
+/// A curb toe has returns on both sides (the road before it, the curb's top behind it);
+/// where the curb hides the road behind it in its shadow, the seen side is the curb top,
+/// which rises; where the vehicle's body hides the curb's top, the face rises between the
+/// toe and the gap, or the top shows past it. What is left is the border of an area the
+/// scanner never reached (the vehicle's own body in the way, a dropout), where the
+/// scanlines end on flat ground.
+fn at_return_gap(
+    input: &BendInput,
+    grid: &PointGrid,
+    t: &Track,
+    k: usize,
+    params: &BendParams,
+) -> bool {
+    let m = t.xyz.len();
+    let (a, b) = (
+        t.xyz[k.saturating_sub(GAP_TANGENT_VERTICES)],
+        t.xyz[(k + GAP_TANGENT_VERTICES).min(m - 1)],
+    );
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let len = dx.hypot(dy);
+    if len.is_nan() || len <= 1e-6 {
+        return false;
+    }
+    let n = [-dy / len, dx / len];
+    let q = t.xyz[k];
+    let disc = |sign: f64, offset: f64| {
+        let c = [q[0] + sign * offset * n[0], q[1] + sign * offset * n[1]];
+        let mut z: Vec<f64> = Vec::new();
+        grid.for_each_within(input.x, input.y, c[0], c[1], GAP_SIDE_RADIUS_M, |i| {
+            if input.z[i].is_finite() {
+                z.push(input.z[i]);
             }
-            let start = k;
-            while k < n && !cov[k] {
-                k += 1;
+        });
+        z
+    };
+    let rise = 0.5 * params.profile_min_step_m;
+    // Second highest of the points within the discs' offset of the vertex on the side
+    // `sign` (one outlier does not make a face).
+    let rises_towards = |sign: f64| {
+        let mut top = [f64::NEG_INFINITY; 2];
+        grid.for_each_within(input.x, input.y, q[0], q[1], GAP_SIDE_OFFSET_M, |i| {
+            let c = (input.x[i] - q[0]) * n[0] + (input.y[i] - q[1]) * n[1];
+            let z = input.z[i];
+            if sign * c > 0.0 && z.is_finite() {
+                if z > top[0] {
+                    top = [z, top[0]];
+                } else if z > top[1] {
+                    top[1] = z;
+                }
             }
-            let piece = Track {
-                points: t.points[start..k].to_vec(),
-                xyz: t.xyz[start..k].to_vec(),
-                side: t.side,
-            };
-            if track_length_m(input, &piece) >= UNCOVERED_KEEP_M {
-                out.push(piece);
+        });
+        top[1] - q[2] >= rise
+    };
+    let (mut left, mut right) = (disc(1.0, GAP_SIDE_OFFSET_M), disc(-1.0, GAP_SIDE_OFFSET_M));
+    // Whether the first returns past the empty disc, within `GAP_LOOK_M`, lie a curb step
+    // above or below the vertex: the gap then hides a step (the curb's face and top in
+    // the body's way), and the vertex is its toe.
+    let step_across_gap = |sign: f64| {
+        let discs = (GAP_LOOK_M / GAP_SIDE_OFFSET_M).round() as u32;
+        for j in 2..=discs {
+            let mut z = disc(sign, j as f64 * GAP_SIDE_OFFSET_M);
+            if let Some(zs) = median(&mut z) {
+                return (zs - q[2]).abs() >= rise;
             }
         }
+        false
+    };
+    let flat_beside_gap = |empty: &[f64], seen: &mut [f64], towards_empty: f64| {
+        empty.is_empty()
+            && seen.len() >= GAP_SEEN_MIN_POINTS
+            && median(seen).is_some_and(|zs| zs - q[2] < rise)
+            && !rises_towards(towards_empty)
+            && !step_across_gap(towards_empty)
+    };
+    flat_beside_gap(&left, &mut right, 1.0) || flat_beside_gap(&right, &mut left, -1.0)
+}
+
+/// Filter 2b: removes tracks along the border of a gap in the returns (see
+/// [`at_return_gap`]): where at least [`GAP_SHARE`] of a track's vertices lie there, those
+/// vertices go and its other stretches of at least [`UNCOVERED_KEEP_M`] stay as tracks of
+/// their own. Each vertex reads the points within [`GAP_LOOK_M`] and a disc's radius of it.
+pub fn remove_at_return_gaps(
+    input: &BendInput,
+    grid: &PointGrid,
+    tracks: Vec<Track>,
+    params: &BendParams,
+) -> Vec<Track> {
+    let mut out = Vec::with_capacity(tracks.len());
+    for t in tracks {
+        let gap: Vec<bool> = (0..t.xyz.len())
+            .map(|k| at_return_gap(input, grid, &t, k, params))
+            .collect();
+        keep_unflagged(input, t, &gap, GAP_SHARE, &mut out);
     }
     out
 }
@@ -646,5 +778,65 @@ mod tests {
         ]);
         let steps: Vec<Option<f64>> = kept.iter().map(|(e, _)| e.curb_height_m).collect();
         assert_eq!(steps, vec![Some(0.29), None]);
+    }
+
+    #[test]
+    fn tracks_along_a_gap_in_the_returns_go_and_curb_toes_stay() {
+        use crate::io::trajectory::Trajectory;
+        // A grid of returns 5 cm apart over 5 m along x. Across it (y): a curb top at
+        // 0.12 m for y < -2, the road from -2 to 1, no returns from 1 to 4 (the vehicle's
+        // body in the way), from 4 to 6 the top of a curb at 0.15 m whose toe at y = 4 the
+        // curb's shadow hides the road before; then, past 4 m without returns, road from
+        // 10 to 10.5 and a curb whose face and top the body hides up to 11.5.
+        let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
+        let rows: Vec<i32> = (-60..=20)
+            .chain(80..=120)
+            .chain(200..=210)
+            .chain(230..=240)
+            .collect();
+        for &iy in &rows {
+            for ix in 0..=100 {
+                x.push(ix as f64 * 0.05);
+                y.push(iy as f64 * 0.05);
+                z.push(if iy < -40 {
+                    0.12
+                } else if iy > 80 && iy <= 120 {
+                    0.15
+                } else if iy >= 230 {
+                    0.2
+                } else {
+                    0.0
+                });
+            }
+        }
+        let n = x.len();
+        let (t, rho) = (vec![0.0; n], vec![0.0f32; n]);
+        let status = vec![Some(PointStatus::Kept); n];
+        let traj = Trajectory::default();
+        let input = BendInput {
+            x: &x,
+            y: &y,
+            z: &z,
+            t: &t,
+            rho_deg: &rho,
+            status: &status,
+            scanline: &vec![0; n],
+            candidates: &[],
+            trajectory: &traj,
+        };
+        let grid = PointGrid::build(&x, &y, 0.1, |_| true);
+        let along = |row: i32| {
+            let k = rows.iter().position(|&r| r == row).unwrap() as u32 * 101;
+            Track::measured(&input, (k..k + 101).collect(), Side::Left)
+        };
+        let (border, toe, shadowed, hidden) = (along(20), along(-40), along(80), along(210));
+        let p = BendParams::default();
+        let kept = remove_at_return_gaps(
+            &input,
+            &grid,
+            vec![border, toe.clone(), shadowed.clone(), hidden.clone()],
+            &p,
+        );
+        assert_eq!(kept, vec![toe, shadowed, hidden]);
     }
 }
