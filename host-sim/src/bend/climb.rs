@@ -11,7 +11,7 @@
 
 use super::grid::PointGrid;
 use super::params::BendParams;
-use super::profile::{profile_toe, usable, ProfileToe};
+use super::profile::{usable, Profile, ProfileToe};
 use super::BendInput;
 
 /// Strips either side of the search position whose ground tells a climbed track: from
@@ -44,7 +44,7 @@ pub(super) const CLIMBED_SHARE: f64 = 0.5;
 /// beside `centre` ([`STRIP_NEAR_M`]–[`STRIP_FAR_M`] across) lies at least
 /// `profile_min_step_m` below `centre` while the other strip's does not (or holds too
 /// few points: an object or its shadow beside the top edge). The toe is then sought by
-/// [`profile_toe`] on profiles `half_l` and `2·half_l` long, centred [`SHIFT_M`]
+/// [`Profile::toe_or_longer`] on the profile `half_l` long, centred [`SHIFT_M`]
 /// towards the low side at the low strip's height, the curb rising away from the low
 /// side, whatever side the track assumed before; it is taken where `centre` lies at least
 /// [`CLIMBED_SHARE`] of its step above it.
@@ -73,8 +73,16 @@ pub fn climbed_toe(
         centre[1] + SHIFT_M * to_road[1],
         low_z,
     ];
-    let toe = profile_toe(input, grid, c, along, up, half_l, params)
-        .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * half_l, params))?;
+    let toe = Profile {
+        input,
+        grid,
+        params,
+        centre: c,
+        along,
+        up,
+        half_l,
+    }
+    .toe_or_longer()?;
     // The track is on the top edge, not a pick or two up the face: at least half the
     // toe's step above it.
     (centre[2] - toe.xyz[2] >= CLIMBED_SHARE * toe.step_m).then_some((toe, up))

@@ -73,8 +73,8 @@ pub struct BendParams {
     pub max_gap_steps: u32,
     /// Whether a step whose search set S holds no point with ρ at or above `stop_rho_deg`
     /// looks for the toe on a virtual profile across the search direction, built from the
-    /// points of several scanlines (`profile::profile_toe`), before it counts as a gap. Not in
-    /// the paper: its ρ is taken along each scanline, so it flattens where a curb turns to
+    /// points of several scanlines (`profile::Profile::toe`), before it counts as a gap. Not
+    /// in the paper: its ρ is taken along each scanline, so it flattens where a curb turns to
     /// run along the scanlines (intersection corners and side streets), while the height
     /// step is still there between the scanlines.
     pub profile_fallback: bool,
@@ -110,7 +110,7 @@ pub struct BendParams {
     /// near lane.
     pub profile_seed_reach_m: f64,
     /// Longest stretch, metres, a track follows a curb cut's toe on virtual profiles
-    /// (`profile::cut_toe`: the break of slope where the lip is under
+    /// (`profile::Profile::cut_toe`: the break of slope where the lip is under
     /// `profile_min_step_m`, down to none) after the bend angle and the step have both
     /// faded (0 = never). Not in the paper: a cut's toe has no bend angle worth the name
     /// and no step, yet it continues the curb's line; where no track waits on the cut's
@@ -120,7 +120,7 @@ pub struct BendParams {
     /// Bend angle, degrees, under which a picked toe is *weak*: road noise reaches it.
     /// Not in the paper; the kernel's τ_min (30°), under which it gives no seed candidate.
     /// A weak pick counts as the curb only where a virtual profile confirms it
-    /// (`profile::profile_toe` or `profile::cut_toe` beside it).
+    /// (`profile::Profile::toe` or `profile::Profile::cut_toe` beside it).
     pub weak_rho_deg: f64,
     /// Longest stretch, metres, a track goes on unconfirmed weak picks and gap steps
     /// before it stops and drops that stretch (0 = no limit). Not in the paper: on a flat

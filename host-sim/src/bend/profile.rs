@@ -23,38 +23,64 @@ pub struct ProfileToe {
     pub step_m: f64,
 }
 
-/// Finds the curb toe on a *virtual profile*: the points (of any scanline) within
-/// `half_l` of the line through `centre` across the horizontal unit
-/// direction `along`, taken as one cross-section with `across` running from the road
-/// (negative) to the curb side (positive, `up` = +1 for the left of `along`, −1 for the
-/// right).
-///
-/// The per-scanline bend angle (Honma et al. §2.3) sees a curb only where the scanline
-/// crosses it; where a curb turns to run along the scanlines (the side streets of
-/// intersections, the far part of corner arcs) every scanline runs beside the toe and ρ
-/// stays flat, while the height step is still there *between* scanlines. The profile
-/// gathers it from several scanlines: the points sorted by `across` are split in two at
-/// the place that minimises the squared deviation from two levels (a least-squares step
-/// fit), and the toe is half-way between the last point of the low part and the first of
-/// the high part. Each part, without the 40 mm next to the toe (the face), is then fitted
-/// by a line, and the toe is accepted only as a curb: a step of at least
-/// `profile_min_step_m` (and under the search half-height) between the two lines at the
-/// toe, both parts ground-like (slopes under `profile_max_slope`, so a curb cut's ramp is
-/// no step; a road part falling to the toe under `profile_max_road_fall`), the lines' RMS under a quarter of the step, ground within 0.15 m on both
-/// sides of the toe, and the toe within `profile_half_width_m` − 0.15 m of the centre.
-pub fn profile_toe(
-    input: &BendInput,
-    grid: &PointGrid,
-    centre: [f64; 3],
-    along: [f64; 2],
-    up: f64,
-    half_l: f64,
-    params: &BendParams,
-) -> Option<ProfileToe> {
-    profile_split(input, grid, centre, along, up, half_l, params).map(|s| s.toe)
+/// A *virtual profile*: the points (of any scanline) within `half_l` of the line through
+/// `centre` across the horizontal unit direction `along`, taken as one cross-section with
+/// `across` running from the road (negative) to the curb side (positive, `up` = +1 for the
+/// left of `along`, −1 for the right). It carries the points, their grid and the
+/// parameters with it, so that each query on a profile ([`Profile::toe`],
+/// [`Profile::cut_toe`], [`Profile::shadow_shift`]) takes the profile alone.
+#[derive(Clone, Copy)]
+pub struct Profile<'a> {
+    pub input: &'a BendInput<'a>,
+    pub grid: &'a PointGrid,
+    pub params: &'a BendParams,
+    pub centre: [f64; 3],
+    pub along: [f64; 2],
+    pub up: f64,
+    pub half_l: f64,
 }
 
-/// The toe of [`profile_toe`] with the offsets across the profile it was split at.
+impl Profile<'_> {
+    /// The same profile, `half_l` long either side of its centre.
+    pub fn with_half_l(self, half_l: f64) -> Self {
+        Self { half_l, ..self }
+    }
+
+    /// The horizontal unit normal from the road towards the curb side.
+    fn across(&self) -> [f64; 2] {
+        let (along, up) = (self.along, self.up);
+        [-along[1] * up, along[0] * up]
+    }
+
+    /// [`Profile::toe`], else the toe on the profile twice as long: far from the scanner
+    /// the points are sparse along the scanlines, and the short profile holds too few.
+    pub fn toe_or_longer(&self) -> Option<ProfileToe> {
+        self.toe()
+            .or_else(|| self.with_half_l(2.0 * self.half_l).toe())
+    }
+
+    /// Finds the curb toe on a virtual profile ([`Profile`]).
+    ///
+    /// The per-scanline bend angle (Honma et al. §2.3) sees a curb only where the scanline
+    /// crosses it; where a curb turns to run along the scanlines (the side streets of
+    /// intersections, the far part of corner arcs) every scanline runs beside the toe and ρ
+    /// stays flat, while the height step is still there *between* scanlines. The profile
+    /// gathers it from several scanlines: the points sorted by `across` are split in two at
+    /// the place that minimises the squared deviation from two levels (a least-squares step
+    /// fit), and the toe is half-way between the last point of the low part and the first of
+    /// the high part. Each part, without the 40 mm next to the toe (the face), is then fitted
+    /// by a line, and the toe is accepted only as a curb: a step of at least
+    /// `profile_min_step_m` (and under the search half-height) between the two lines at the
+    /// toe, both parts ground-like (slopes under `profile_max_slope`, so a curb cut's ramp is
+    /// no step; a road part falling to the toe under `profile_max_road_fall`), the lines'
+    /// RMS under a quarter of the step, ground within 0.15 m on both sides of the toe, and
+    /// the toe within `profile_half_width_m` − 0.15 m of the centre.
+    pub fn toe(&self) -> Option<ProfileToe> {
+        self.split().map(|s| s.toe)
+    }
+}
+
+/// The toe of [`Profile::toe`] with the offsets across the profile it was split at.
 #[derive(Clone, Copy, Debug)]
 struct Split {
     toe: ProfileToe,
@@ -70,202 +96,149 @@ struct Split {
 /// the curb's shadow rather than the face, metres.
 const SHADOW_MIN_GAP_M: f64 = 0.1;
 
-/// How far across, towards the curb, a toe that [`profile_toe`] finds on the profile
-/// through `centre` lies from where it puts it, with that toe: half of the way from the
-/// middle of the gap between the road and the curb points to the first curb point where
-/// that gap is the curb's shadow ([`in_shadow`]), else 0.
-///
-/// Across a shadow the returns beside the toe are the curb's (the scanner looks at the
-/// curb from behind and sees its top up to the arris), while the road before it is
-/// hidden for the shadow's length, so the middle of the gap lies on the road. The toe
-/// lies between the middle and the first curb return: the arris lies a face's width
-/// behind the toe, and the first return up to a point spacing behind the arris.
-pub fn shadow_shift(
-    input: &BendInput,
-    grid: &PointGrid,
-    centre: [f64; 3],
-    along: [f64; 2],
-    up: f64,
-    half_l: f64,
-    params: &BendParams,
-) -> Option<(ProfileToe, f64)> {
-    let s = profile_split(input, grid, centre, along, up, half_l, params)?;
-    let shadow = s.first_high - s.last_low >= SHADOW_MIN_GAP_M
-        && in_shadow(
-            input,
-            grid,
-            centre,
-            along,
-            up,
-            half_l,
-            params,
-            s.at,
-            &[s.last_low, s.first_high],
-        );
-    let shift = if shadow {
-        0.5 * (s.first_high - s.at)
-    } else {
-        0.0
-    };
-    Some((s.toe, shift))
-}
+impl Profile<'_> {
+    /// How far across, towards the curb, a toe that [`Profile::toe`] finds on the profile
+    /// lies from where it puts it, with that toe: half of the way from the
+    /// middle of the gap between the road and the curb points to the first curb point where
+    /// that gap is the curb's shadow ([`Profile::in_shadow`]), else 0.
+    ///
+    /// Across a shadow the returns beside the toe are the curb's (the scanner looks at the
+    /// curb from behind and sees its top up to the arris), while the road before it is
+    /// hidden for the shadow's length, so the middle of the gap lies on the road. The toe
+    /// lies between the middle and the first curb return: the arris lies a face's width
+    /// behind the toe, and the first return up to a point spacing behind the arris.
+    pub fn shadow_shift(&self) -> Option<(ProfileToe, f64)> {
+        let s = self.split()?;
+        let shadow = s.first_high - s.last_low >= SHADOW_MIN_GAP_M
+            && self.in_shadow(s.at, &[s.last_low, s.first_high]);
+        let shift = if shadow {
+            0.5 * (s.first_high - s.at)
+        } else {
+            0.0
+        };
+        Some((s.toe, shift))
+    }
 
-/// Whether the scanner stood on the curb's side of the toe (offset `toe` across) when it
-/// measured the profile's points at the offsets `at`: there the raised curb hides the road
-/// just past the toe (the curb's shadow). `false` where the trajectory does not cover a
-/// point's time.
-#[allow(clippy::too_many_arguments)]
-fn in_shadow(
-    input: &BendInput,
-    grid: &PointGrid,
-    centre: [f64; 3],
-    along: [f64; 2],
-    up: f64,
-    half_l: f64,
-    params: &BendParams,
-    toe: f64,
-    at: &[f64],
-) -> bool {
-    let n = [-along[1] * up, along[0] * up];
-    let (mut any, mut all) = (false, true);
-    for_each_on_profile(input, grid, centre, along, up, half_l, params, |i, c, _| {
-        if at.contains(&c) {
-            any = true;
-            all &= input
-                .trajectory
-                .pose_at(input.t[i])
-                .is_some_and(|p| (p.x - centre[0]) * n[0] + (p.y - centre[1]) * n[1] > toe);
-        }
-    });
-    any && all
-}
-
-/// [`profile_toe`]'s search, with the offsets it split the profile at.
-fn profile_split(
-    input: &BendInput,
-    grid: &PointGrid,
-    centre: [f64; 3],
-    along: [f64; 2],
-    up: f64,
-    half_l: f64,
-    params: &BendParams,
-) -> Option<Split> {
-    let half_w = params.profile_half_width_m;
-    let n = [-along[1] * up, along[0] * up];
-    const MIN_SIDE: usize = 4;
-    let prof = gather(input, grid, centre, along, up, half_l, params);
-    if prof.len() < 2 * MIN_SIDE {
-        return None;
-    }
-    let m = prof.len();
-    let sums = Sums::new(&prof);
-    let line = |lo: usize, hi: usize| sums.line(lo, hi);
-    let acc = &sums.acc;
-    // Σ(z − mean)² over prof[lo..hi].
-    let level_sse = |lo: usize, hi: usize| {
-        let (n, sz, szz) = (
-            (hi - lo) as f64,
-            acc[hi][3] - acc[lo][3],
-            acc[hi][5] - acc[lo][5],
-        );
-        (szz - sz * sz / n).max(0.0)
-    };
-    // Best split k: prof[..k] road, prof[k..] curb, each part one level. Points on the curb
-    // face go to the nearer level, so the split falls at the face's middle.
-    let mut best: Option<(f64, usize)> = None;
-    for k in MIN_SIDE..=m - MIN_SIDE {
-        if prof[k].0 - prof[k - 1].0 <= 0.0 {
-            continue; // a split must fall between two distinct positions
-        }
-        let e = level_sse(0, k) + level_sse(k, m);
-        if best.is_none_or(|(be, _)| e < be) {
-            best = Some((e, k));
-        }
-    }
-    let (_, k) = best?;
-    let toe = 0.5 * (prof[k - 1].0 + prof[k].0);
-    const NEAR_M: f64 = 0.15;
-    if prof[k].0 - prof[k - 1].0 > 2.0 * NEAR_M || toe.abs() > half_w - NEAR_M {
-        return None;
-    }
-    // The two parts without the face (FACE_M either side of the toe), each fitted by a
-    // line (road cross slope, sidewalk fall).
-    const FACE_M: f64 = 0.04;
-    let lo = prof.partition_point(|p| p.0 < toe - FACE_M);
-    let hi = prof.partition_point(|p| p.0 <= toe + FACE_M);
-    if lo < MIN_SIDE || m - hi < MIN_SIDE {
-        return None;
-    }
-    if prof[lo - 1].0 < toe - NEAR_M || prof[hi].0 > toe + NEAR_M {
-        return None; // no ground seen right beside the toe
-    }
-    let (la, lb, le) = line(0, lo);
-    let (ha, hb, he) = line(hi, m);
-    let step = (ha + hb * toe) - (la + lb * toe);
-    let rms = ((le + he) / (lo + m - hi) as f64).sqrt();
-    // Both parts must be ground, not a ramp or a car's flank; the road may fall to the
-    // toe more steeply (a gutter, a grade across a side street's curb).
-    let max_slope = params.profile_max_slope;
-    if lb > max_slope || -lb > params.profile_max_road_fall || hb.abs() > max_slope {
-        return None;
-    }
-    if step < params.profile_min_step_m || step > params.search_half_height_m {
-        return None;
-    }
-    if rms > 0.25 * step {
-        return None;
-    }
-    // The road height at the toe: the low points within NEAR_M of it.
-    let near_low: Vec<f64> = prof[..k]
-        .iter()
-        .filter(|p| toe - p.0 <= NEAR_M)
-        .map(|p| p.1)
-        .collect();
-    let z = near_low.iter().sum::<f64>() / near_low.len().max(1) as f64;
-    // Along the profile the toe sits among the points beside it, not at the centre: where
-    // the scanned area ends, the centre lies past the last scanline.
-    let near: Vec<f64> = prof
-        .iter()
-        .filter(|p| (p.0 - toe).abs() <= NEAR_M)
-        .map(|p| p.2)
-        .collect();
-    let a = near.iter().sum::<f64>() / near.len().max(1) as f64;
-    Some(Split {
-        toe: ProfileToe {
-            xyz: [
-                centre[0] + a * along[0] + toe * n[0],
-                centre[1] + a * along[1] + toe * n[1],
-                z,
-            ],
-            step_m: step,
-        },
-        at: toe,
-        last_low: prof[k - 1].0,
-        first_high: prof[k].0,
-    })
-}
-
-/// The points of a virtual profile (see [`profile_toe`]) as (across, z, along), sorted by
-/// `across`, then height.
-fn gather(
-    input: &BendInput,
-    grid: &PointGrid,
-    centre: [f64; 3],
-    along: [f64; 2],
-    up: f64,
-    half_l: f64,
-    params: &BendParams,
-) -> Vec<(f64, f64, f64)> {
-    SCRATCH.with_borrow_mut(|s| {
-        s.prof.clear();
-        for_each_on_profile(input, grid, centre, along, up, half_l, params, |i, c, a| {
-            s.prof.push((c, input.z[i], a))
+    /// Whether the scanner stood on the curb's side of the toe (offset `toe` across) when it
+    /// measured the profile's points at the offsets `at`: there the raised curb hides the road
+    /// just past the toe (the curb's shadow). `false` where the trajectory does not cover a
+    /// point's time.
+    fn in_shadow(&self, toe: f64, at: &[f64]) -> bool {
+        let (input, centre) = (self.input, self.centre);
+        let n = self.across();
+        let (mut any, mut all) = (false, true);
+        self.for_each(|i, c, _| {
+            if at.contains(&c) {
+                any = true;
+                all &= input
+                    .trajectory
+                    .pose_at(input.t[i])
+                    .is_some_and(|p| (p.x - centre[0]) * n[0] + (p.y - centre[1]) * n[1] > toe);
+            }
         });
-        sort_across(&s.prof, &mut s.keys, &mut s.starts)
-    })
+        any && all
+    }
+
+    /// [`Profile::toe`]'s search, with the offsets it split the profile at.
+    fn split(&self) -> Option<Split> {
+        let (params, centre, along) = (self.params, self.centre, self.along);
+        let half_w = params.profile_half_width_m;
+        let n = self.across();
+        const MIN_SIDE: usize = 4;
+        let prof = self.gather();
+        if prof.len() < 2 * MIN_SIDE {
+            return None;
+        }
+        let m = prof.len();
+        let sums = Sums::new(&prof);
+        let line = |lo: usize, hi: usize| sums.line(lo, hi);
+        let acc = &sums.acc;
+        // Σ(z − mean)² over prof[lo..hi].
+        let level_sse = |lo: usize, hi: usize| {
+            let (n, sz, szz) = (
+                (hi - lo) as f64,
+                acc[hi][3] - acc[lo][3],
+                acc[hi][5] - acc[lo][5],
+            );
+            (szz - sz * sz / n).max(0.0)
+        };
+        // Best split k: prof[..k] road, prof[k..] curb, each part one level. Points on the curb
+        // face go to the nearer level, so the split falls at the face's middle.
+        let mut best: Option<(f64, usize)> = None;
+        for k in MIN_SIDE..=m - MIN_SIDE {
+            if prof[k].0 - prof[k - 1].0 <= 0.0 {
+                continue; // a split must fall between two distinct positions
+            }
+            let e = level_sse(0, k) + level_sse(k, m);
+            if best.is_none_or(|(be, _)| e < be) {
+                best = Some((e, k));
+            }
+        }
+        let (_, k) = best?;
+        let toe = 0.5 * (prof[k - 1].0 + prof[k].0);
+        const NEAR_M: f64 = 0.15;
+        if prof[k].0 - prof[k - 1].0 > 2.0 * NEAR_M || toe.abs() > half_w - NEAR_M {
+            return None;
+        }
+        // The two parts without the face (FACE_M either side of the toe), each fitted by a
+        // line (road cross slope, sidewalk fall).
+        const FACE_M: f64 = 0.04;
+        let lo = prof.partition_point(|p| p.0 < toe - FACE_M);
+        let hi = prof.partition_point(|p| p.0 <= toe + FACE_M);
+        if lo < MIN_SIDE || m - hi < MIN_SIDE {
+            return None;
+        }
+        if prof[lo - 1].0 < toe - NEAR_M || prof[hi].0 > toe + NEAR_M {
+            return None; // no ground seen right beside the toe
+        }
+        let (la, lb, le) = line(0, lo);
+        let (ha, hb, he) = line(hi, m);
+        let step = (ha + hb * toe) - (la + lb * toe);
+        let rms = ((le + he) / (lo + m - hi) as f64).sqrt();
+        // Both parts must be ground, not a ramp or a car's flank; the road may fall to the
+        // toe more steeply (a gutter, a grade across a side street's curb).
+        let max_slope = params.profile_max_slope;
+        if lb > max_slope || -lb > params.profile_max_road_fall || hb.abs() > max_slope {
+            return None;
+        }
+        if step < params.profile_min_step_m || step > params.search_half_height_m {
+            return None;
+        }
+        if rms > 0.25 * step {
+            return None;
+        }
+        // The road height at the toe: the low points within NEAR_M of it.
+        let near_low: Vec<f64> = prof[..k]
+            .iter()
+            .filter(|p| toe - p.0 <= NEAR_M)
+            .map(|p| p.1)
+            .collect();
+        let z = near_low.iter().sum::<f64>() / near_low.len().max(1) as f64;
+        // Along the profile the toe sits among the points beside it, not at the centre: where
+        // the scanned area ends, the centre lies past the last scanline.
+        let near: Vec<f64> = prof
+            .iter()
+            .filter(|p| (p.0 - toe).abs() <= NEAR_M)
+            .map(|p| p.2)
+            .collect();
+        let a = near.iter().sum::<f64>() / near.len().max(1) as f64;
+        Some(Split {
+            toe: ProfileToe {
+                xyz: [
+                    centre[0] + a * along[0] + toe * n[0],
+                    centre[1] + a * along[1] + toe * n[1],
+                    z,
+                ],
+                step_m: step,
+            },
+            at: toe,
+            last_low: prof[k - 1].0,
+            first_high: prof[k].0,
+        })
+    }
 }
 
-/// A thread's buffers for [`gather`]: the points as the grid hands them over and the sort's
+/// A thread's buffers for [`Profile::gather`]: the points as the grid hands them over and the sort's
 /// keys and buckets, kept from one profile to the next (a section gathers thousands of
 /// profiles of a few thousand points each; growing fresh vectors for each cost more than
 /// sorting them).
@@ -280,38 +253,48 @@ std::thread_local! {
     static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
 }
 
-/// Calls `f(i, across, along)` for every usable point `i` of a virtual profile (see
-/// [`profile_toe`]): within `profile_half_width_m` across and `half_l` along of `centre`,
-/// and within the search half-height of its height.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn for_each_on_profile(
-    input: &BendInput,
-    grid: &PointGrid,
-    centre: [f64; 3],
-    along: [f64; 2],
-    up: f64,
-    half_l: f64,
-    params: &BendParams,
-    mut f: impl FnMut(usize, f64, f64),
-) {
-    let half_w = params.profile_half_width_m;
-    let n = [-along[1] * up, along[0] * up];
-    grid.for_each_in_rect(
-        input.x,
-        input.y,
-        [centre[0], centre[1]],
-        along,
-        n,
-        half_l,
-        half_w,
-        half_w.hypot(half_l),
-        |i, c, a| {
-            if !usable(input, i) || (input.z[i] - centre[2]).abs() > params.search_half_height_m {
-                return;
-            }
-            f(i, c, a);
-        },
-    );
+impl Profile<'_> {
+    /// The profile's points as (across, z, along), sorted by `across`, then height.
+    fn gather(&self) -> Vec<(f64, f64, f64)> {
+        let input = self.input;
+        SCRATCH.with_borrow_mut(|s| {
+            s.prof.clear();
+            self.for_each(|i, c, a| s.prof.push((c, input.z[i], a)));
+            sort_across(&s.prof, &mut s.keys, &mut s.starts)
+        })
+    }
+
+    /// Calls `f(i, across, along)` for every usable point `i` of the profile: within
+    /// `profile_half_width_m` across and `half_l` along of `centre`, and within the search
+    /// half-height of its height.
+    pub(super) fn for_each(&self, mut f: impl FnMut(usize, f64, f64)) {
+        let (input, params, centre, along, half_l) = (
+            self.input,
+            self.params,
+            self.centre,
+            self.along,
+            self.half_l,
+        );
+        let half_w = params.profile_half_width_m;
+        let n = self.across();
+        self.grid.for_each_in_rect(
+            input.x,
+            input.y,
+            [centre[0], centre[1]],
+            along,
+            n,
+            half_l,
+            half_w,
+            half_w.hypot(half_l),
+            |i, c, a| {
+                if !usable(input, i) || (input.z[i] - centre[2]).abs() > params.search_half_height_m
+                {
+                    return;
+                }
+                f(i, c, a);
+            },
+        );
+    }
 }
 
 /// `prof` sorted by `across`, then height, by `total_cmp`, points equal in both kept in
@@ -444,91 +427,86 @@ const CUT_MAX_RAMP: f64 = 0.6;
 /// the largest range noise of the scanners simulated and modelled.
 const CUT_MAX_RMS_M: f64 = 0.02;
 
-/// Finds the toe of a *curb cut* on a virtual profile (the same points as
-/// [`profile_toe`]): where the lip is too low for a step (0–50 mm, down to none) the toe is
-/// the break of slope between the road, falling towards the curb line, and the lip, ramp
-/// or lowered sidewalk behind it, rising away from it. The sorted points are split in two
-/// where two independent least-squares lines fit them best; the split is accepted as the
-/// toe when the road part is ground-like (slope under `profile_max_slope`), the part
-/// behind it rises no steeper than [`CUT_MAX_RAMP`] and at least [`CUT_MIN_RISE_M`] above the
-/// road's line [`CUT_RISE_AT_M`] behind the toe (and never falls below it at the toe), the
-/// lines fit within [`CUT_MAX_RMS_M`], ground is seen within 0.15 m on both sides, and the
-/// toe lies within [`CUT_MAX_OFFSET_M`] of the centre. Meant only for continuing a track
-/// along a curb line, where the prediction says where the toe is: on its own the break
-/// would be too weak a sign of a curb.
-pub fn cut_toe(
-    input: &BendInput,
-    grid: &PointGrid,
-    centre: [f64; 3],
-    along: [f64; 2],
-    up: f64,
-    half_l: f64,
-    params: &BendParams,
-) -> Option<ProfileToe> {
-    const MIN_SIDE: usize = 6;
-    const NEAR_M: f64 = 0.15;
-    let n = [-along[1] * up, along[0] * up];
-    let prof = gather(input, grid, centre, along, up, half_l, params);
-    let m = prof.len();
-    if m < 2 * MIN_SIDE {
-        return None;
-    }
-    let sums = Sums::new(&prof);
-    let z0 = prof[0].1;
-    let mut best: Option<(f64, usize)> = None;
-    for k in MIN_SIDE..=m - MIN_SIDE {
-        if prof[k].0 - prof[k - 1].0 <= 0.0 {
-            continue;
+impl Profile<'_> {
+    /// Finds the toe of a *curb cut* on the profile (the same points as
+    /// [`Profile::toe`]): where the lip is too low for a step (0–50 mm, down to none) the toe is
+    /// the break of slope between the road, falling towards the curb line, and the lip, ramp
+    /// or lowered sidewalk behind it, rising away from it. The sorted points are split in two
+    /// where two independent least-squares lines fit them best; the split is accepted as the
+    /// toe when the road part is ground-like (slope under `profile_max_slope`), the part
+    /// behind it rises no steeper than [`CUT_MAX_RAMP`] and at least [`CUT_MIN_RISE_M`] above the
+    /// road's line [`CUT_RISE_AT_M`] behind the toe (and never falls below it at the toe), the
+    /// lines fit within [`CUT_MAX_RMS_M`], ground is seen within 0.15 m on both sides, and the
+    /// toe lies within [`CUT_MAX_OFFSET_M`] of the centre. Meant only for continuing a track
+    /// along a curb line, where the prediction says where the toe is: on its own the break
+    /// would be too weak a sign of a curb.
+    pub fn cut_toe(&self) -> Option<ProfileToe> {
+        let (params, centre, along) = (self.params, self.centre, self.along);
+        const MIN_SIDE: usize = 6;
+        const NEAR_M: f64 = 0.15;
+        let n = self.across();
+        let prof = self.gather();
+        let m = prof.len();
+        if m < 2 * MIN_SIDE {
+            return None;
         }
+        let sums = Sums::new(&prof);
+        let z0 = prof[0].1;
+        let mut best: Option<(f64, usize)> = None;
+        for k in MIN_SIDE..=m - MIN_SIDE {
+            if prof[k].0 - prof[k - 1].0 <= 0.0 {
+                continue;
+            }
+            let toe = 0.5 * (prof[k - 1].0 + prof[k].0);
+            if toe.abs() > CUT_MAX_OFFSET_M {
+                continue;
+            }
+            let e = sums.line(0, k).2 + sums.line(k, m).2;
+            if best.is_none_or(|(be, _)| e < be) {
+                best = Some((e, k));
+            }
+        }
+        let (sse, k) = best?;
         let toe = 0.5 * (prof[k - 1].0 + prof[k].0);
-        if toe.abs() > CUT_MAX_OFFSET_M {
-            continue;
+        if prof[k].0 - toe > NEAR_M || toe - prof[k - 1].0 > NEAR_M {
+            return None; // no ground seen right beside the toe
         }
-        let e = sums.line(0, k).2 + sums.line(k, m).2;
-        if best.is_none_or(|(be, _)| e < be) {
-            best = Some((e, k));
+        // Both parts must reach far enough from the toe for their slopes to mean something.
+        if toe - prof[0].0 < 2.0 * NEAR_M || prof[m - 1].0 - toe < 2.0 * NEAR_M {
+            return None;
         }
-    }
-    let (sse, k) = best?;
-    let toe = 0.5 * (prof[k - 1].0 + prof[k].0);
-    if prof[k].0 - toe > NEAR_M || toe - prof[k - 1].0 > NEAR_M {
-        return None; // no ground seen right beside the toe
-    }
-    // Both parts must reach far enough from the toe for their slopes to mean something.
-    if toe - prof[0].0 < 2.0 * NEAR_M || prof[m - 1].0 - toe < 2.0 * NEAR_M {
-        return None;
-    }
-    let (la, lb, _) = sums.line(0, k);
-    let (ha, hb, _) = sums.line(k, m);
-    if lb.abs() > params.profile_max_slope || hb > CUT_MAX_RAMP {
-        return None;
-    }
-    let road = |c: f64| la + lb * c;
-    let back = |c: f64| ha + hb * c;
-    let step = back(toe) - road(toe);
-    let rise = back(toe + CUT_RISE_AT_M) - road(toe + CUT_RISE_AT_M);
-    let rms = (sse / m as f64).sqrt();
-    if step < -0.005 || rise < CUT_MIN_RISE_M.max(rms) || rms > CUT_MAX_RMS_M {
-        return None;
-    }
-    let a = prof
-        .iter()
-        .filter(|p| (p.0 - toe).abs() <= NEAR_M)
-        .map(|p| p.2)
-        .sum::<f64>()
-        / prof
+        let (la, lb, _) = sums.line(0, k);
+        let (ha, hb, _) = sums.line(k, m);
+        if lb.abs() > params.profile_max_slope || hb > CUT_MAX_RAMP {
+            return None;
+        }
+        let road = |c: f64| la + lb * c;
+        let back = |c: f64| ha + hb * c;
+        let step = back(toe) - road(toe);
+        let rise = back(toe + CUT_RISE_AT_M) - road(toe + CUT_RISE_AT_M);
+        let rms = (sse / m as f64).sqrt();
+        if step < -0.005 || rise < CUT_MIN_RISE_M.max(rms) || rms > CUT_MAX_RMS_M {
+            return None;
+        }
+        let a = prof
             .iter()
             .filter(|p| (p.0 - toe).abs() <= NEAR_M)
-            .count()
-            .max(1) as f64;
-    Some(ProfileToe {
-        xyz: [
-            centre[0] + a * along[0] + toe * n[0],
-            centre[1] + a * along[1] + toe * n[1],
-            z0 + road(toe),
-        ],
-        step_m: step.max(0.0),
-    })
+            .map(|p| p.2)
+            .sum::<f64>()
+            / prof
+                .iter()
+                .filter(|p| (p.0 - toe).abs() <= NEAR_M)
+                .count()
+                .max(1) as f64;
+        Some(ProfileToe {
+            xyz: [
+                centre[0] + a * along[0] + toe * n[0],
+                centre[1] + a * along[1] + toe * n[1],
+                z0 + road(toe),
+            ],
+            step_m: step.max(0.0),
+        })
+    }
 }
 
 #[cfg(test)]
@@ -567,15 +545,16 @@ mod tests {
         };
         let grid = PointGrid::build(&x, &y, 0.1, |_| true);
         // Walking along +y with the curb on the right (+x).
-        profile_toe(
-            &input,
-            &grid,
-            [0.0, 0.0, 0.0],
-            [0.0, 1.0],
-            -1.0,
-            0.15,
+        Profile {
+            input: &input,
+            grid: &grid,
             params,
-        )
+            centre: [0.0, 0.0, 0.0],
+            along: [0.0, 1.0],
+            up: -1.0,
+            half_l: 0.15,
+        }
+        .toe()
     }
 
     #[test]

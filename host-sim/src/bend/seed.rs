@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use super::grid::PointGrid;
 use super::params::{widened, BendParams};
-use super::profile::{profile_toe, usable};
+use super::profile::{usable, Profile};
 use super::route::Route;
 use super::BendInput;
 use crate::model::Side;
@@ -96,7 +96,7 @@ const PROFILE_SEED_NEAR_M: f64 = 1.0;
 /// steps leave no stretch unseen.
 const PROFILE_SEED_STEP_M: f64 = 0.5;
 
-/// Seeds from virtual profiles (`profile::profile_toe`), one per interval and side at most.
+/// Seeds from virtual profiles (`profile::Profile::toe`), one per interval and side at most.
 ///
 /// At the middle of each interval of L_s along the route, profiles across the driving
 /// direction are tried outward from [`PROFILE_SEED_NEAR_M`] to `profile_seed_reach_m`
@@ -195,7 +195,16 @@ fn first_toe_outward(
             continue;
         };
         let at = [centre[0], centre[1], z];
-        let Some(toe) = profile_toe(input, grid, at, fwd, up, half_l, params) else {
+        let profile = Profile {
+            input,
+            grid,
+            params,
+            centre: at,
+            along: fwd,
+            up,
+            half_l,
+        };
+        let Some(toe) = profile.toe() else {
             continue;
         };
         return nearest_usable(input, grid, toe.xyz, params.search_radius_m);

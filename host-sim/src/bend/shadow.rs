@@ -1,17 +1,15 @@
 //! Virtual toes across the curb's shadow. Where the scanlines run along a curb seen from
 //! behind (a side street's curb seen from the main road past the corner), the raised curb
-//! hides the road just before the toe, and a virtual profile ([`profile_toe`]) holds no
+//! hides the road just before the toe, and a virtual profile ([`Profile::toe`]) holds no
 //! road points there: its toe, half-way between the last road and the first curb point,
 //! lies on the road. The tracker follows the toes as found (its search positions stay on
 //! the line it has followed); afterwards each virtual vertex is moved across, towards the
-//! curb, by the shift [`shadow_shift`] finds on the profile through it. Measured vertices
-//! and vertices whose profile shows no shadow stay where they are.
-//!
-//! [`profile_toe`]: super::profile::profile_toe
+//! curb, by the shift [`Profile::shadow_shift`] finds on the profile through it. Measured
+//! vertices and vertices whose profile shows no shadow stay where they are.
 
 use super::grid::PointGrid;
 use super::params::BendParams;
-use super::profile::shadow_shift;
+use super::profile::Profile;
 use super::track::Track;
 use super::BendInput;
 
@@ -48,9 +46,16 @@ pub fn place_shadowed_toes(
                 let v = t.xyz[k];
                 for up in [1.0, -1.0] {
                     for half_l in [l, 2.0 * l] {
-                        let Some((toe, shift)) =
-                            shadow_shift(input, grid, v, along, up, half_l, params)
-                        else {
+                        let profile = Profile {
+                            input,
+                            grid,
+                            params,
+                            centre: v,
+                            along,
+                            up,
+                            half_l,
+                        };
+                        let Some((toe, shift)) = profile.shadow_shift() else {
                             continue;
                         };
                         if (toe.xyz[0] - v[0]).hypot(toe.xyz[1] - v[1]) > SAME_TOE_M {

@@ -1,11 +1,11 @@
 //! The curb toe on a virtual profile whose scanlines run along the curb: a step between
-//! scanline levels, for the side streets of intersections where [`profile_toe`] sees too
+//! scanline levels, for the side streets of intersections where [`Profile::toe`] sees too
 //! few points spread across.
 //!
 //! Where a curb runs nearly along the scanlines (a side street's curb, the far part of a
 //! corner arc) a profile across it holds a few scanlines, each at one offset across: the
 //! ones on the road at road level, the ones on the sidewalk about a curb height higher,
-//! perhaps one on the face between them. [`profile_toe`] fits two lines to the points and
+//! perhaps one on the face between them. [`Profile::toe`] fits two lines to the points and
 //! asks for points right beside the toe on both sides and flat parts; with the points
 //! bunched at a few offsets one scanline on the face tilts a part, or the nearest scanline
 //! lies more than 0.15 m from the toe, and it sees no toe. Here each scanline is one
@@ -15,12 +15,10 @@
 //! scanline; the gap between them is held to the ordinary profile's reach unless the
 //! scanner stood on the curb's side (the curb's shadow). The step must continue the track
 //! that reaches it: its curb height and its line.
-//!
-//! [`profile_toe`]: super::profile::profile_toe
 
 use super::grid::PointGrid;
 use super::params::BendParams;
-use super::profile::{for_each_on_profile, usable, ProfileToe};
+use super::profile::{usable, Profile, ProfileToe};
 use super::{median, BendInput};
 
 /// Fewest points of a scanline on the profile for it to give a level.
@@ -106,17 +104,10 @@ fn fit(levels: &[Level]) -> (f64, f64, f64) {
 
 /// The levels of the scanlines on a virtual profile (see [`sparse_toe`]), sorted by offset.
 /// `None` when a scanline spreads across the profile (not the sparse case).
-fn levels(
-    input: &BendInput,
-    grid: &PointGrid,
-    centre: [f64; 3],
-    along: [f64; 2],
-    up: f64,
-    half_l: f64,
-    params: &BendParams,
-) -> Option<Vec<Level>> {
+fn levels(profile: &Profile) -> Option<Vec<Level>> {
+    let input = profile.input;
     let mut pts: Vec<(u32, f64, f64, f64, f64)> = Vec::new();
-    for_each_on_profile(input, grid, centre, along, up, half_l, params, |i, c, a| {
+    profile.for_each(|i, c, a| {
         pts.push((input.scanline[i], c, input.z[i], a, input.t[i]));
     });
     pts.sort_by_key(|p| p.0);
@@ -154,8 +145,8 @@ fn levels(
     Some(out)
 }
 
-/// Finds the curb toe on a virtual profile (the points of [`profile_toe`]'s profile, with
-/// `across` from the road, negative, to the curb side) as a step between scanline levels.
+/// Finds the curb toe on a virtual profile ([`Profile`]: its points, with `across` from
+/// the road, negative, to the curb side) as a step between scanline levels.
 /// The scanlines sorted by offset are split where two lines, one through the road
 /// scanlines' levels and one through the curb scanlines' (one scanline between them may
 /// be left out: the face), fit best; the toe is accepted when each side has at least
@@ -166,29 +157,27 @@ fn levels(
 /// near edges of the road and curb scanlines beside the step lie at most [`MAX_GAP_M`]
 /// apart, their centres as far apart or, across the curb's shadow ([`is_shadow`]), at most
 /// [`MAX_SHADOW_GAP_M`]. The toe is half-way between those edges. Meant for where
-/// [`profile_toe`] finds nothing: each scanline at one offset is the case it cannot take.
+/// [`Profile::toe`] finds nothing: each scanline at one offset is the case it cannot take.
 ///
 /// A step between scanlines also shows where the returns have a gap or something other
 /// than the curb stands on the road, so the toe must also continue the track that reaches
-/// it (`picked`, its vertices before the step; `centre` is its search position, the line
-/// or arc it is on carried one step on):
+/// it (`picked`, its vertices before the step; the profile's `centre` is its search
+/// position, the line or arc it is on carried one step on):
 /// - the step matches the track's curb height ([`track_curb_height`]) within
 ///   [`CURB_MATCH_SHARE`] of it (no toe where the track has no curb height);
 /// - the toe lies within [`MAX_OFF_LINE_M`] across of `centre`.
 ///
-/// [`profile_toe`]: super::profile::profile_toe
-#[allow(clippy::too_many_arguments)]
-pub fn sparse_toe(
-    input: &BendInput,
-    grid: &PointGrid,
-    picked: &[(u32, [f64; 3])],
-    centre: [f64; 3],
-    along: [f64; 2],
-    up: f64,
-    half_l: f64,
-    params: &BendParams,
-) -> Option<ProfileToe> {
-    let lv = levels(input, grid, centre, along, up, half_l, params)?;
+pub fn sparse_toe(profile: &Profile, picked: &[(u32, [f64; 3])]) -> Option<ProfileToe> {
+    let Profile {
+        input,
+        grid,
+        params,
+        centre,
+        along,
+        up,
+        ..
+    } = *profile;
+    let lv = levels(profile)?;
     let m = lv.len();
     if m < 2 * MIN_SIDE_LINES {
         return None;
@@ -204,7 +193,7 @@ pub fn sparse_toe(
         first_high.c - 0.5 * first_high.spread,
     );
     let toe = 0.5 * (road_edge + curb_edge);
-    let reach = if is_shadow(input, centre, along, up, toe, &[last_low, first_high]) {
+    let reach = if is_shadow(profile, toe, &[last_low, first_high]) {
         MAX_SHADOW_GAP_M
     } else {
         MAX_GAP_M
@@ -282,18 +271,18 @@ fn best_split(lv: &[Level]) -> Option<(usize, usize)> {
 
 /// Whether the road between the scanlines `beside` the step (the last road and the first
 /// curb scanline) can be the curb's shadow: at each one's mean time the scanner stood on
-/// the curb's side of the toe line (offset across from `centre` beyond `toe`), so the
-/// raised curb hid the road just past it. Seen from the road's side a curb hides no road,
-/// and a gap there is a gap in the returns. `false` where the trajectory does not cover a
-/// scanline's time.
-fn is_shadow(
-    input: &BendInput,
-    centre: [f64; 3],
-    along: [f64; 2],
-    up: f64,
-    toe: f64,
-    beside: &[Level],
-) -> bool {
+/// the curb's side of the toe line (offset across from the profile's centre beyond
+/// `toe`), so the raised curb hid the road just past it. Seen from the road's side a curb
+/// hides no road, and a gap there is a gap in the returns. `false` where the trajectory
+/// does not cover a scanline's time.
+fn is_shadow(profile: &Profile, toe: f64, beside: &[Level]) -> bool {
+    let Profile {
+        input,
+        centre,
+        along,
+        up,
+        ..
+    } = *profile;
     let n = [-along[1] * up, along[0] * up];
     beside.iter().all(|l| {
         input.trajectory.pose_at(l.t).is_some_and(|p| {
@@ -485,16 +474,16 @@ mod tests {
         let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
         let params = BendParams::default();
         // Along +y, the curb rising to the right (x > 0): up = −1.
-        sparse_toe(
-            &input,
-            &grid,
-            &l.picked,
-            [centre_x, 0.0, 0.0],
-            [0.0, 1.0],
-            -1.0,
-            0.3,
-            &params,
-        )
+        let profile = Profile {
+            input: &input,
+            grid: &grid,
+            params: &params,
+            centre: [centre_x, 0.0, 0.0],
+            along: [0.0, 1.0],
+            up: -1.0,
+            half_l: 0.3,
+        };
+        sparse_toe(&profile, &l.picked)
     }
 
     /// Seen from the road side (the scanner at x = −5).

@@ -12,7 +12,7 @@ use super::claims::{Claims, Join};
 use super::climb::{climbed_toe, CLIMBED_SHARE};
 use super::grid::PointGrid;
 use super::params::{widened, BendParams};
-use super::profile::{cut_toe, profile_toe, usable, ProfileToe};
+use super::profile::{usable, Profile, ProfileToe};
 use super::seed::Seed;
 use super::sparse::sparse_toe;
 use super::BendInput;
@@ -22,7 +22,7 @@ use crate::replay::PointStatus;
 /// One tracked edge: its vertices in order along the driving direction.
 ///
 /// A vertex is either a measured point (its id is the point's index into the columns) or
-/// a toe found on a virtual profile ([`profile_toe`]) between the points (its id is at
+/// a toe found on a virtual profile ([`Profile::toe`]) between the points (its id is at
 /// least the number of points, unique within one run). `xyz` holds every vertex's
 /// position, so nothing downstream needs to tell the two apart.
 #[derive(Clone, Debug, PartialEq)]
@@ -257,7 +257,7 @@ const DIR_BASE_M: f64 = 0.5;
 const MAX_TOE_DZ_M: f64 = 0.04;
 
 /// Vertices a track must have before it may follow a curb cut's toe
-/// (`profile::cut_toe`): 1.5 m of curb, so that the break of slope is only ever followed
+/// ([`Profile::cut_toe`]): 1.5 m of curb, so that the break of slope is only ever followed
 /// along a line already tracked.
 const CUT_MIN_TRACK_STEPS: usize = 10;
 
@@ -362,7 +362,16 @@ fn cut_on_line(
     }
     let (q, a) = line_ahead(picked, cur, along, d_s)?;
     let l = 2.0 * params.profile_half_length_m;
-    let toe = cut_toe(input, grid, [q[0], q[1], cur[2]], a, up, l, params)?;
+    let toe = Profile {
+        input,
+        grid,
+        params,
+        centre: [q[0], q[1], cur[2]],
+        along: a,
+        up,
+        half_l: l,
+    }
+    .cut_toe()?;
     let ahead = (toe.xyz[0] - cur[0]) * along[0] + (toe.xyz[1] - cur[1]) * along[1];
     (ahead > 0.25 * d_s).then_some((toe, a))
 }
@@ -398,24 +407,19 @@ fn along_the_road(input: &BendInput, picked: &[(u32, [f64; 3])], start: u32, a: 
     (a[0] * f[0] + a[1] * f[1]).abs() >= ALONG_ROAD_MAX_DEG.to_radians().cos()
 }
 
-/// The toe on a [`widened`] profile `half_l` long, for a track
-/// along the road where the profiles of the default width show none.
+/// The toe on `profile` [`widened`], for a track along the road where the profiles of the
+/// default width show none.
 ///
 /// Far from the scanner, on a curb its scanlines cross at a grazing angle, the profiles of
 /// the default width find no toe along stretches of a curb in plain view, and the track
 /// ends in gaps there; a wider profile holds more ground on either side of the step and
 /// reaches a toe farther from the search position.
-#[allow(clippy::too_many_arguments)]
-fn wide_toe(
-    input: &BendInput,
-    grid: &PointGrid,
-    centre: [f64; 3],
-    along: [f64; 2],
-    up: f64,
-    half_l: f64,
-    params: &BendParams,
-) -> Option<ProfileToe> {
-    profile_toe(input, grid, centre, along, up, half_l, &widened(params))
+fn wide_toe(profile: Profile) -> Option<ProfileToe> {
+    Profile {
+        params: &widened(profile.params),
+        ..profile
+    }
+    .toe()
 }
 
 /// `v` (a unit vector) turned to the horizontal heading `a` (a unit vector), keeping its
@@ -449,7 +453,7 @@ fn unit3(v: [f64; 3]) -> Option<[f64; 3]> {
 
 /// Tracks from `start` along `dir0` until the stop rule of §2.7 fires or another track is
 /// reached. Where S holds no point with ρ of at least the stop threshold, the toe is looked
-/// for on a virtual profile across the search direction ([`profile_toe`]; the curb rises
+/// for on a virtual profile across the search direction ([`Profile::toe`]; the curb rises
 /// on the side `up` of the direction: +1 left, −1 right) before the step counts as a gap.
 /// `prior_steps` counts the vertices the track already has behind `start` (the other
 /// direction's), which count towards [`CUT_MIN_TRACK_STEPS`].
@@ -549,14 +553,24 @@ fn track_one_way(
                 // A track along the road tries a wider profile next (a far curb crossed at
                 // a grazing angle). Where the scanlines run along the curb, each at one
                 // offset across the profile, the step between their levels shows the toe.
-                let toe = profile_toe(input, grid, c, along, up, l, params)
-                    .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params))
+                let profile = Profile {
+                    input,
+                    grid,
+                    params,
+                    centre: c,
+                    along,
+                    up,
+                    half_l: l,
+                };
+                let long = profile.with_half_l(2.0 * l);
+                let toe = profile
+                    .toe_or_longer()
                     .or_else(|| {
                         along_the_road(input, &picked, start, along)
-                            .then(|| wide_toe(input, grid, c, along, up, 2.0 * l, params))
+                            .then(|| wide_toe(long))
                             .flatten()
                     })
-                    .or_else(|| sparse_toe(input, grid, &picked, c, along, up, 2.0 * l, params));
+                    .or_else(|| sparse_toe(&long, &picked));
                 // Neither ρ nor a step: a curb cut's toe continues the curb's line as a
                 // break of slope, followed for at most `cut_follow_max_m`, and only by a
                 // track that has followed a curb before it.
@@ -573,7 +587,12 @@ fn track_one_way(
                         // not one step along v: v follows the scatter of the toes before.
                         let line = line_ahead(&picked, cur, along, d_s);
                         let (cc, ca) = line.map_or((c, along), |(p, a)| ([p[0], p[1], cur[2]], a));
-                        let t = cut_toe(input, grid, cc, ca, up, 2.0 * l, params);
+                        let t = Profile {
+                            centre: cc,
+                            along: ca,
+                            ..long
+                        }
+                        .cut_toe();
                         if t.is_some() {
                             cut_run_m += d_s;
                             cut_from.get_or_insert(picked.len());
@@ -688,11 +707,18 @@ fn track_one_way(
             let along = [vh[0] / vh_len, vh[1] / vh_len];
             let c = [pred[0], pred[1], cur[2]];
             let l = params.profile_half_length_m;
+            let profile = Profile {
+                input,
+                grid,
+                params,
+                centre: c,
+                along,
+                up,
+                half_l: l,
+            };
+            let long = profile.with_half_l(2.0 * l);
             match (jumped && params.profile_fallback && *next_virtual < u32::MAX)
-                .then(|| {
-                    profile_toe(input, grid, c, along, up, l, params)
-                        .or_else(|| profile_toe(input, grid, c, along, up, 2.0 * l, params))
-                })
+                .then(|| profile.toe_or_longer())
                 .flatten()
                 .filter(|t| {
                     (t.xyz[0] - cur[0]) * along[0] + (t.xyz[1] - cur[1]) * along[1] > 0.25 * d_s
@@ -734,13 +760,8 @@ fn track_one_way(
                                 && params.cut_follow_max_m > 0.0;
                             let confirmed = side_step(input, grid, n, along)
                                 .is_some_and(|d| d * up >= WEAK_CONFIRM_STEP_M)
-                                || profile_toe(input, grid, c, along, up, 2.0 * l, params)
-                                    .filter(near)
-                                    .is_some()
-                                || (cut_ok
-                                    && cut_toe(input, grid, c, along, up, 2.0 * l, params)
-                                        .filter(near)
-                                        .is_some());
+                                || long.toe().filter(near).is_some()
+                                || (cut_ok && long.cut_toe().filter(near).is_some());
                             if confirmed {
                                 weak_run_m = 0.0;
                                 weak_from = None;
@@ -980,56 +1001,38 @@ mod tests {
         let params = BendParams::default();
         // Across the side street's curb (x = 10) at y = 11, walking north: the curb rises
         // on the left (towards −x).
-        let toe = profile_toe(
-            &inp,
-            &grid,
-            [10.1, 11.0, 0.0],
-            [0.0, 1.0],
-            1.0,
-            0.15,
-            &params,
-        )
-        .expect("a toe");
+        let across = Profile {
+            input: &inp,
+            grid: &grid,
+            params: &params,
+            centre: [10.1, 11.0, 0.0],
+            along: [0.0, 1.0],
+            up: 1.0,
+            half_l: 0.15,
+        };
+        let toe = across.toe().expect("a toe");
         assert!((toe.xyz[0] - 10.0).abs() < 0.06, "{toe:?}");
         assert!((toe.step_m - 0.15).abs() < 0.01, "{toe:?}");
         // With the wrong side up there is no curb (the ground falls).
-        assert!(profile_toe(
-            &inp,
-            &grid,
-            [10.1, 11.0, 0.0],
-            [0.0, 1.0],
-            -1.0,
-            0.15,
-            &params
-        )
-        .is_none());
+        assert!(Profile { up: -1.0, ..across }.toe().is_none());
         // A flat road gives nothing.
-        assert!(profile_toe(
-            &inp,
-            &grid,
-            [13.0, 2.0, 0.0],
-            [0.0, 1.0],
-            1.0,
-            0.15,
-            &params
-        )
-        .is_none());
+        let flat = Profile {
+            centre: [13.0, 2.0, 0.0],
+            ..across
+        };
+        assert!(flat.toe().is_none());
         // A 20 % ramp (z = 0.2·x) is no step.
         let ramp_z: Vec<f64> = c.x.iter().map(|&x| 0.2 * x).collect();
         let ramp = BendInput {
             z: &ramp_z,
             ..input(&c)
         };
-        assert!(profile_toe(
-            &ramp,
-            &grid,
-            [13.0, 2.0, 2.6],
-            [0.0, 1.0],
-            1.0,
-            0.15,
-            &params
-        )
-        .is_none());
+        let on_ramp = Profile {
+            input: &ramp,
+            centre: [13.0, 2.0, 2.6],
+            ..flat
+        };
+        assert!(on_ramp.toe().is_none());
     }
 
     /// A curb along y = 5 (sidewalk 0.15 m up beyond it) from x = 0 to `curb_end`, seen by
@@ -1221,8 +1224,17 @@ mod tests {
         let grid = PointGrid::build(inp.x, inp.y, 0.1, |_| true);
         let params = BendParams::default();
         let centre = [3.0, 5.0 - 0.38, 0.0];
-        assert!(profile_toe(&inp, &grid, centre, [1.0, 0.0], 1.0, 0.3, &params).is_none());
-        let toe = wide_toe(&inp, &grid, centre, [1.0, 0.0], 1.0, 0.3, &params).expect("a toe");
+        let profile = Profile {
+            input: &inp,
+            grid: &grid,
+            params: &params,
+            centre,
+            along: [1.0, 0.0],
+            up: 1.0,
+            half_l: 0.3,
+        };
+        assert!(profile.toe().is_none());
+        let toe = wide_toe(profile).expect("a toe");
         assert!((toe.xyz[1] - 5.0).abs() < 0.03, "{toe:?}");
         assert!((toe.step_m - 0.15).abs() < 0.01, "{toe:?}");
     }
