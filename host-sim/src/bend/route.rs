@@ -4,6 +4,7 @@
 
 use super::grid::PointGrid;
 use crate::io::trajectory::Trajectory;
+use std::cmp::Ordering;
 
 /// Horizontal route of the trajectory with cumulative arc length.
 pub struct Route {
@@ -141,13 +142,13 @@ impl Route {
     /// The route segment (index of its first sample) passing closest to `q`, searched among
     /// the samples within 4 m (of arc) of the nearest kept vertex.
     fn segment_near(&self, q: [f64; 2]) -> Option<usize> {
-        let mut best: Option<(f64, usize)> = None;
+        let mut best: Option<([f64; 2], usize)> = None;
         let mut r = 2.0 * DECIMATE_M;
         while best.is_none() && r < 1e7 {
             self.grid
                 .for_each_within(&self.x, &self.y, q[0], q[1], r, |k| {
-                    let d = (self.x[k] - q[0]).hypot(self.y[k] - q[1]);
-                    if best.is_none_or(|(bd, bk)| d < bd || (d == bd && k < bk)) {
+                    let d = [self.x[k] - q[0], self.y[k] - q[1]];
+                    if best.is_none_or(|(bd, bk)| nearer_first(d, k, bd, bk)) {
                         best = Some((d, k));
                     }
                 });
@@ -160,7 +161,7 @@ impl Route {
             .s
             .partition_point(|&s| s <= s0 + 4.0)
             .min(self.s.len() - 1);
-        let mut out: Option<(f64, usize)> = None;
+        let mut out: Option<([f64; 2], usize)> = None;
         for k in lo..=hi {
             let e = (k + 1).min(self.s.len() - 1);
             let (ax, ay, dx, dy) = (
@@ -175,8 +176,8 @@ impl Route {
             } else {
                 0.0
             };
-            let d = (ax + u * dx - q[0]).hypot(ay + u * dy - q[1]);
-            if out.is_none_or(|(bd, _)| d < bd) {
+            let d = [ax + u * dx - q[0], ay + u * dy - q[1]];
+            if out.is_none_or(|(bd, _)| shorter(d, bd) == Some(Ordering::Less)) {
                 out = Some((d, k));
             }
         }
@@ -195,12 +196,12 @@ impl Route {
             return None;
         }
         // Nearest kept vertex: widen the disc until it holds one.
-        let mut best: Option<(f64, usize)> = None;
+        let mut best: Option<([f64; 2], usize)> = None;
         let mut r = 10.0;
         while best.is_none() && r < 1e7 {
             self.grid.for_each_within(&self.x, &self.y, px, py, r, |k| {
-                let d = (self.x[k] - px).hypot(self.y[k] - py);
-                if best.is_none_or(|(bd, bk)| d < bd || (d == bd && k < bk)) {
+                let d = [self.x[k] - px, self.y[k] - py];
+                if best.is_none_or(|(bd, bk)| nearer_first(d, k, bd, bk)) {
                     best = Some((d, k));
                 }
             });
@@ -217,7 +218,7 @@ impl Route {
             .s
             .partition_point(|&s| s <= s0 + 2.0 * DECIMATE_M)
             .min(self.s.len() - 1);
-        let mut best_p = ([self.x[k0], self.y[k0]], f64::INFINITY, k0);
+        let mut best_p = ([self.x[k0], self.y[k0]], [f64::INFINITY, 0.0], k0);
         for k in lo..=hi {
             let seg_end = (k + 1).min(hi);
             let (ax, ay) = (self.x[k], self.y[k]);
@@ -230,13 +231,52 @@ impl Route {
                 0.0
             };
             let q = [ax + u * dx, ay + u * dy];
-            let d = (q[0] - px).hypot(q[1] - py);
-            if d < best_p.1 {
+            let d = [q[0] - px, q[1] - py];
+            if shorter(d, best_p.1) == Some(Ordering::Less) {
                 best_p = (q, d, k);
             }
         }
         let h = self.heading_deg[best_p.2].to_radians();
         Some((best_p.0, [h.sin(), h.cos()]))
+    }
+}
+
+/// Squared lengths closer than this (relative) are compared by `hypot` itself.
+const SQUARED_TIE: f64 = 1e-9;
+
+/// Squared lengths below this are compared by `hypot` itself (squares of smaller
+/// components lose their relative precision).
+const SQUARED_TINY: f64 = 1e-250;
+
+/// Compares the lengths of two horizontal offsets exactly as comparing their `hypot`s
+/// would (`None` where one is NaN), without calling `hypot` unless the two are within
+/// `SQUARED_TIE` of each other.
+///
+/// `a² + b²` in floating point is within a few ulps of the true square (for squares
+/// above `SQUARED_TINY`, finite) and `hypot` within an ulp or two of the true length: two
+/// squares `SQUARED_TIE` apart have lengths that far apart, beyond both errors, so their
+/// `hypot`s order as the squares do. Nearer ties, infinities and NaNs go to `hypot`, so
+/// the nearest point and its ties (broken by index) are those of a `hypot` comparison.
+fn shorter(a: [f64; 2], b: [f64; 2]) -> Option<Ordering> {
+    let (sa, sb) = (a[0] * a[0] + a[1] * a[1], b[0] * b[0] + b[1] * b[1]);
+    if sa.is_finite() && sb.is_finite() && sa.max(sb) >= SQUARED_TINY {
+        if sa < sb * (1.0 - SQUARED_TIE) {
+            return Some(Ordering::Less);
+        }
+        if sb < sa * (1.0 - SQUARED_TIE) {
+            return Some(Ordering::Greater);
+        }
+    }
+    a[0].hypot(a[1]).partial_cmp(&b[0].hypot(b[1]))
+}
+
+/// True when offset `d` of vertex `k` is nearer than offset `bd` of vertex `bk`, ties
+/// going to the lower index.
+fn nearer_first(d: [f64; 2], k: usize, bd: [f64; 2], bk: usize) -> bool {
+    match shorter(d, bd) {
+        Some(Ordering::Less) => true,
+        Some(Ordering::Equal) => k < bk,
+        _ => false,
     }
 }
 
@@ -268,6 +308,49 @@ mod tests {
         assert_eq!(r.arc_at(50.0), Some(0.0));
         let f = r.forward_at(104.0).unwrap();
         assert!((f[0] - 1.0).abs() < 1e-12 && f[1].abs() < 1e-12);
+    }
+
+    #[test]
+    fn shorter_orders_as_hypot_does() {
+        let hyp = |a: [f64; 2], b: [f64; 2]| a[0].hypot(a[1]).partial_cmp(&b[0].hypot(b[1]));
+        let up = |v: f64, k: u64| f64::from_bits(v.to_bits() + k);
+        let mut seed = 7u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 20.0 - 10.0
+        };
+        for _ in 0..20_000 {
+            let a = [next(), next()];
+            // The same length turned, neighbouring ulps, and an unrelated offset.
+            let r = a[0].hypot(a[1]);
+            let cands = [
+                [a[1], a[0]],
+                [-a[0], a[1]],
+                [up(a[0].abs(), 1), a[1]],
+                [a[0], up(a[1].abs(), 3)],
+                [r, 0.0],
+                [0.0, up(r, 1)],
+                [next(), next()],
+            ];
+            for b in cands {
+                assert_eq!(shorter(a, b), hyp(a, b), "{a:?} {b:?}");
+                assert_eq!(shorter(b, a), hyp(b, a), "{b:?} {a:?}");
+            }
+        }
+        let odd = [
+            [f64::NAN, 1.0],
+            [f64::INFINITY, 0.0],
+            [1e200, 1e200],
+            [1e-200, 0.0],
+            [0.0, -0.0],
+        ];
+        for a in odd {
+            for b in odd {
+                assert_eq!(shorter(a, b), hyp(a, b), "{a:?} {b:?}");
+            }
+        }
     }
 
     #[test]
