@@ -555,26 +555,13 @@ mod tests {
     /// sidewalk rising 2 % away from it), points every 2 cm across and 5 cm along, the road
     /// at `road(x)` for x < 0.
     fn toe_beside(road: impl Fn(f64) -> f64, params: &BendParams) -> Option<ProfileToe> {
-        let ground = |px: f64, _: f64| if px < 0.0 { road(px) } else { 0.15 + 0.02 * px };
-        on_profile(ground, params, |p: &Profile| p.toe())
-    }
-
-    /// `query` on a profile across ground of height `ground(x, y)`, points every 2 cm
-    /// across (x from −0.44 to 0.44) and 5 cm along, walking along +y with the curb side
-    /// towards +x.
-    fn on_profile<R>(
-        ground: impl Fn(f64, f64) -> f64,
-        params: &BendParams,
-        query: impl Fn(&Profile) -> R,
-    ) -> R {
         let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
         for i in 0..45 {
             for j in 0..13 {
                 let px = -0.45 + 0.02 * f64::from(i) + 0.01;
-                let py = -0.3 + 0.05 * f64::from(j);
                 x.push(px);
-                y.push(py);
-                z.push(ground(px, py));
+                y.push(-0.3 + 0.05 * f64::from(j));
+                z.push(if px < 0.0 { road(px) } else { 0.15 + 0.02 * px });
             }
         }
         let n = x.len();
@@ -595,7 +582,7 @@ mod tests {
         };
         let grid = PointGrid::build(&x, &y, 0.1, |_| true);
         // Walking along +y with the curb on the right (+x).
-        query(&Profile {
+        Profile {
             input: &input,
             grid: &grid,
             params,
@@ -603,29 +590,8 @@ mod tests {
             along: [0.0, 1.0],
             up: -1.0,
             half_l: 0.15,
-        })
-    }
-
-    /// Range noise of ±3 mm, fixed by the point's place.
-    fn noise(x: f64, y: f64) -> f64 {
-        let k = (x * 1000.0).round() as i64 * 31 + (y * 1000.0).round() as i64 * 17;
-        (k.rem_euclid(7) - 3) as f64 * 0.001
-    }
-
-    #[test]
-    fn a_flush_crossing_without_a_lip_shows_its_toe_by_the_break_of_slope() {
-        let params = BendParams::default();
-        // The road falls 2 % to the toe at x = 0, the lowered sidewalk rises 1.5 % behind
-        // it: 9 mm over the road's line 0.25 m behind the toe, no lip, no ramp.
-        let flush = |x: f64, y: f64| if x < 0.0 { -0.02 * x } else { 0.015 * x } + noise(x, y);
-        let toe = on_profile(flush, &params, |p: &Profile| p.cut_toe()).expect("a flush cut's toe");
-        assert!(toe.xyz[0].abs() < 0.05, "{toe:?}");
-        assert!(toe.step_m < 0.005, "{toe:?}");
-        // A road's own line, straight or with a crown, is no cut's toe.
-        let straight = |x: f64, y: f64| -0.02 * x + noise(x, y);
-        assert!(on_profile(straight, &params, |p: &Profile| p.cut_toe()).is_none());
-        let crown = |x: f64, y: f64| -0.02 * x.abs() + noise(x, y);
-        assert!(on_profile(crown, &params, |p: &Profile| p.cut_toe()).is_none());
+        }
+        .toe()
     }
 
     #[test]
