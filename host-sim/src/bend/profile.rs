@@ -386,22 +386,6 @@ impl Sums {
         Self { acc }
     }
 
-    /// Standard error of the slope of [`Sums::line`] over prof[lo..hi]; infinite when the
-    /// run has fewer than three points or a single position.
-    fn slope_se(&self, lo: usize, hi: usize) -> f64 {
-        let (n, sc, scc) = (
-            self.acc[hi][0] - self.acc[lo][0],
-            self.acc[hi][1] - self.acc[lo][1],
-            self.acc[hi][2] - self.acc[lo][2],
-        );
-        let sxx = scc - sc * sc / n.max(1.0);
-        if n < 3.0 || sxx <= 1e-12 {
-            return f64::INFINITY;
-        }
-        let sse = self.line(lo, hi).2;
-        (sse / (n - 2.0) / sxx).sqrt()
-    }
-
     /// Line z = a + b·c over prof[lo..hi]: (a, b, sse), heights relative to the first
     /// point. Slope 0 when the run has a single position (one scanline beside a side
     /// street's curb).
@@ -443,19 +427,6 @@ const CUT_MAX_RAMP: f64 = 0.6;
 /// the largest range noise of the scanners simulated and modelled.
 const CUT_MAX_RMS_M: f64 = 0.02;
 
-/// Least change of slope at a *flush* cut's toe, where no lip and no ramp give the rise of
-/// [`CUT_MIN_RISE_M`]: the road falling to the toe at its crossfall (1–3 %) meets a lowered
-/// sidewalk rising away at its own slope (1.5–2 %), a bend of 2.5 % or more; a road's own
-/// line, straight or gently curved across 0.9 m, bends far less.
-const CUT_MIN_BEND: f64 = 0.02;
-
-/// Standard errors the bend of a flush cut's toe must clear: the two slopes are fitted
-/// over 0.3–0.5 m each, and range noise alone turns them by a percent or two on a sparse
-/// profile. A weak bend places its toe loosely (the best split wanders across the
-/// profile), so only a clear one continues the track; a weaker one leaves the cut to
-/// a bridge, as before.
-const CUT_BEND_SIGMAS: f64 = 5.0;
-
 impl Profile<'_> {
     /// Finds the toe of a *curb cut* on the profile (the same points as
     /// [`Profile::toe`]): where the lip is too low for a step (0–50 mm, down to none) the toe is
@@ -466,12 +437,9 @@ impl Profile<'_> {
     /// behind it rises no steeper than [`CUT_MAX_RAMP`] and at least [`CUT_MIN_RISE_M`] above the
     /// road's line [`CUT_RISE_AT_M`] behind the toe (and never falls below it at the toe), the
     /// lines fit within [`CUT_MAX_RMS_M`], ground is seen within 0.15 m on both sides, and the
-    /// toe lies within [`CUT_MAX_OFFSET_M`] of the centre. A flush crossing with no lip rises
-    /// behind the toe only at the sidewalk's own slope, less than [`CUT_MIN_RISE_M`]: its
-    /// toe counts instead where the part behind rises and the slope turns upwards at the
-    /// toe by at least [`CUT_MIN_BEND`] and [`CUT_BEND_SIGMAS`] standard errors. Meant only
-    /// for continuing a track along a curb line, where the prediction says where the toe
-    /// is: on its own the break would be too weak a sign of a curb.
+    /// toe lies within [`CUT_MAX_OFFSET_M`] of the centre. Meant only for continuing a track
+    /// along a curb line, where the prediction says where the toe is: on its own the break
+    /// would be too weak a sign of a curb.
     pub fn cut_toe(&self) -> Option<ProfileToe> {
         let (params, centre, along) = (self.params, self.centre, self.along);
         const MIN_SIDE: usize = 6;
@@ -517,12 +485,7 @@ impl Profile<'_> {
         let step = back(toe) - road(toe);
         let rise = back(toe + CUT_RISE_AT_M) - road(toe + CUT_RISE_AT_M);
         let rms = (sse / m as f64).sqrt();
-        let raised = rise >= CUT_MIN_RISE_M.max(rms);
-        let bend = hb - lb;
-        let flush = hb > 0.0
-            && bend >= CUT_MIN_BEND
-            && bend >= CUT_BEND_SIGMAS * sums.slope_se(0, k).hypot(sums.slope_se(k, m));
-        if step < -0.005 || !(raised || flush) || rms > CUT_MAX_RMS_M {
+        if step < -0.005 || rise < CUT_MIN_RISE_M.max(rms) || rms > CUT_MAX_RMS_M {
             return None;
         }
         let a = prof
