@@ -96,6 +96,10 @@ const PROFILE_SEED_NEAR_M: f64 = 1.0;
 /// steps leave no stretch unseen.
 const PROFILE_SEED_STEP_M: f64 = 0.5;
 
+/// How many times longer along the road the last outward search's profiles are than the
+/// first two's in [`profile_seeds`].
+const SPARSE_LENGTH_FACTOR: f64 = 2.0;
+
 /// Seeds from virtual profiles (`profile::Profile::toe`), one per interval and side at most.
 ///
 /// At the middle of each interval of L_s along the route, profiles across the driving
@@ -112,6 +116,12 @@ const PROFILE_SEED_STEP_M: f64 = 0.5;
 /// [`widened`]: on a far curb that its scanlines cross at a grazing angle, where the core
 /// has no candidates, the profiles of the default width find no toe in most intervals
 /// (see `track::wide_toe`), and a curb without a seed is never tracked.
+///
+/// Where neither finds a toe, the search is made once more with profiles
+/// [`SPARSE_LENGTH_FACTOR`] times as long along the road: on a far curb the returns lie
+/// decimetres apart across, and a short profile has no ground right beside the toe on one
+/// side (the tracker's `profile::Profile::toe_or_longer` does the same). Short stretches
+/// of curb seen between parked vehicles are then seeded as well.
 ///
 /// Only the interval range the input's points cover is searched, so a streaming window
 /// seeds its own stretch.
@@ -156,16 +166,19 @@ pub fn profile_seeds(
             .flat_map_iter(|&l| sides.iter().map(move |&s| (l, s)))
             .filter_map(|((interval, p, fwd), (side, up))| {
                 let n = [-fwd[1] * up, fwd[0] * up];
-                let first = |params: &BendParams| {
+                let first = |params: &BendParams, half_l: f64| {
                     first_toe_outward(input, grid, p, fwd, n, up, half_l, reach, params)
                 };
-                first(params).or_else(|| first(&wide)).map(|point| Seed {
-                    point,
-                    side,
-                    dir: fwd,
-                    interval,
-                    inlier_ratio: 0.0,
-                })
+                first(params, half_l)
+                    .or_else(|| first(&wide, half_l))
+                    .or_else(|| first(params, SPARSE_LENGTH_FACTOR * half_l))
+                    .map(|point| Seed {
+                        point,
+                        side,
+                        dir: fwd,
+                        interval,
+                        inlier_ratio: 0.0,
+                    })
             }),
     );
     out
