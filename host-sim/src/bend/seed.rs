@@ -426,6 +426,88 @@ mod tests {
         assert!(a.is_some());
     }
 
+    /// A far curb 8 m left of a drive east along y = 0 (the road level below y = 8 m, the
+    /// sidewalk 0.12 m up beyond it): scanlines every 0.1 m along, their returns 0.45 m
+    /// apart across, each line's offset 2.25 cm past the one before, as on a curb its
+    /// scanlines cross at a grazing angle. A profile 0.6 m long holds no return right beside
+    /// the toe on one side; one 1.2 m long does.
+    #[test]
+    fn a_sparse_far_curb_is_seeded_from_longer_profiles() {
+        use crate::io::trajectory::{Pose, Trajectory};
+        const T0: f64 = 400_000_000.0;
+        let (mut x, mut y, mut z, mut t) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for k in 0..300 {
+            let px = 0.1 * f64::from(k);
+            let mut py = 6.0 + (0.05 * f64::from(k)).fract() * 0.45;
+            while py < 10.0 {
+                x.push(px);
+                y.push(py);
+                z.push(if py < 8.0 {
+                    0.0
+                } else {
+                    0.12 + 0.02 * (py - 8.0)
+                });
+                t.push(T0 + px / 10.0);
+                py += 0.45;
+            }
+        }
+        let n = x.len();
+        let (rho, scanline) = (vec![0.0f32; n], vec![0u32; n]);
+        let status = vec![Some(crate::replay::PointStatus::Kept); n];
+        let samples = (-10..=40)
+            .map(|k| Pose {
+                t: T0 + 0.1 * f64::from(k),
+                x: f64::from(k),
+                y: 0.0,
+                z: 2.0,
+                roll_deg: 0.0,
+                pitch_deg: 0.0,
+                heading_deg: 90.0,
+            })
+            .collect();
+        let trajectory = Trajectory { samples };
+        let input = BendInput {
+            x: &x,
+            y: &y,
+            z: &z,
+            t: &t,
+            rho_deg: &rho,
+            status: &status,
+            scanline: &scanline,
+            candidates: &[],
+            trajectory: &trajectory,
+        };
+        let params = BendParams::default();
+        let grid = PointGrid::build(&x, &y, params.search_radius_m, |_| true);
+        let route = Route::new(&trajectory);
+        // Neither the default nor the widened profiles find the toe anywhere.
+        let half_l = 2.0 * params.profile_half_length_m;
+        for p in [&params, &widened(&params)] {
+            for c in 0..15 {
+                let at = [1.0 + 2.0 * f64::from(c), 0.0];
+                let toe = first_toe_outward(
+                    &input,
+                    &grid,
+                    at,
+                    [1.0, 0.0],
+                    [0.0, 1.0],
+                    1.0,
+                    half_l,
+                    15.0,
+                    p,
+                );
+                assert_eq!(toe, None, "a toe at {at:?}");
+            }
+        }
+        let seeds = profile_seeds(&input, &grid, &route, &params);
+        let left: Vec<&Seed> = seeds.iter().filter(|s| s.side == Side::Left).collect();
+        assert!(left.len() >= 12, "{} left seeds", left.len());
+        for s in left {
+            let i = s.point as usize;
+            assert!((y[i] - 8.0).abs() <= 0.1, "seed at y = {:.3}", y[i]);
+        }
+    }
+
     #[test]
     fn too_few_inliers_give_no_seed() {
         // Points scattered on a circle of radius 1 m: no three collinear within 40 mm.
