@@ -96,6 +96,10 @@ const PROFILE_SEED_NEAR_M: f64 = 1.0;
 /// steps leave no stretch unseen.
 const PROFILE_SEED_STEP_M: f64 = 0.5;
 
+/// How many times longer along the road the last outward search's profiles are than the
+/// first two's in [`profile_seeds`].
+const SPARSE_LENGTH_FACTOR: f64 = 2.0;
+
 /// Seeds from virtual profiles (`profile::Profile::toe`), one per interval and side at most.
 ///
 /// At the middle of each interval of L_s along the route, profiles across the driving
@@ -112,6 +116,12 @@ const PROFILE_SEED_STEP_M: f64 = 0.5;
 /// [`widened`]: on a far curb that its scanlines cross at a grazing angle, where the core
 /// has no candidates, the profiles of the default width find no toe in most intervals
 /// (see `track::wide_toe`), and a curb without a seed is never tracked.
+///
+/// Where neither finds a toe, the search is made once more with profiles
+/// [`SPARSE_LENGTH_FACTOR`] times as long along the road: on a far curb the returns lie
+/// decimetres apart across, and a short profile has no ground right beside the toe on one
+/// side (the tracker's `profile::Profile::toe_or_longer` does the same). Short stretches
+/// of curb seen between parked vehicles are then seeded as well.
 ///
 /// Only the interval range the input's points cover is searched, so a streaming window
 /// seeds its own stretch.
@@ -156,16 +166,19 @@ pub fn profile_seeds(
             .flat_map_iter(|&l| sides.iter().map(move |&s| (l, s)))
             .filter_map(|((interval, p, fwd), (side, up))| {
                 let n = [-fwd[1] * up, fwd[0] * up];
-                let first = |params: &BendParams| {
+                let first = |params: &BendParams, half_l: f64| {
                     first_toe_outward(input, grid, p, fwd, n, up, half_l, reach, params)
                 };
-                first(params).or_else(|| first(&wide)).map(|point| Seed {
-                    point,
-                    side,
-                    dir: fwd,
-                    interval,
-                    inlier_ratio: 0.0,
-                })
+                first(params, half_l)
+                    .or_else(|| first(&wide, half_l))
+                    .or_else(|| first(params, SPARSE_LENGTH_FACTOR * half_l))
+                    .map(|point| Seed {
+                        point,
+                        side,
+                        dir: fwd,
+                        interval,
+                        inlier_ratio: 0.0,
+                    })
             }),
     );
     out
@@ -411,6 +424,88 @@ mod tests {
         let b = ransac_line(&x, &y, &pts, &p, 99);
         assert_eq!(a, b);
         assert!(a.is_some());
+    }
+
+    /// A far curb 8 m left of a drive east along y = 0 (the road level below y = 8 m, the
+    /// sidewalk 0.12 m up beyond it): scanlines every 0.1 m along, their returns 0.45 m
+    /// apart across, each line's offset 2.25 cm past the one before, as on a curb its
+    /// scanlines cross at a grazing angle. A profile 0.6 m long holds no return right beside
+    /// the toe on one side; one 1.2 m long does.
+    #[test]
+    fn a_sparse_far_curb_is_seeded_from_longer_profiles() {
+        use crate::io::trajectory::{Pose, Trajectory};
+        const T0: f64 = 400_000_000.0;
+        let (mut x, mut y, mut z, mut t) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for k in 0..300 {
+            let px = 0.1 * f64::from(k);
+            let mut py = 6.0 + (0.05 * f64::from(k)).fract() * 0.45;
+            while py < 10.0 {
+                x.push(px);
+                y.push(py);
+                z.push(if py < 8.0 {
+                    0.0
+                } else {
+                    0.12 + 0.02 * (py - 8.0)
+                });
+                t.push(T0 + px / 10.0);
+                py += 0.45;
+            }
+        }
+        let n = x.len();
+        let (rho, scanline) = (vec![0.0f32; n], vec![0u32; n]);
+        let status = vec![Some(crate::replay::PointStatus::Kept); n];
+        let samples = (-10..=40)
+            .map(|k| Pose {
+                t: T0 + 0.1 * f64::from(k),
+                x: f64::from(k),
+                y: 0.0,
+                z: 2.0,
+                roll_deg: 0.0,
+                pitch_deg: 0.0,
+                heading_deg: 90.0,
+            })
+            .collect();
+        let trajectory = Trajectory { samples };
+        let input = BendInput {
+            x: &x,
+            y: &y,
+            z: &z,
+            t: &t,
+            rho_deg: &rho,
+            status: &status,
+            scanline: &scanline,
+            candidates: &[],
+            trajectory: &trajectory,
+        };
+        let params = BendParams::default();
+        let grid = PointGrid::build(&x, &y, params.search_radius_m, |_| true);
+        let route = Route::new(&trajectory);
+        // Neither the default nor the widened profiles find the toe anywhere.
+        let half_l = 2.0 * params.profile_half_length_m;
+        for p in [&params, &widened(&params)] {
+            for c in 0..15 {
+                let at = [1.0 + 2.0 * f64::from(c), 0.0];
+                let toe = first_toe_outward(
+                    &input,
+                    &grid,
+                    at,
+                    [1.0, 0.0],
+                    [0.0, 1.0],
+                    1.0,
+                    half_l,
+                    15.0,
+                    p,
+                );
+                assert_eq!(toe, None, "a toe at {at:?}");
+            }
+        }
+        let seeds = profile_seeds(&input, &grid, &route, &params);
+        let left: Vec<&Seed> = seeds.iter().filter(|s| s.side == Side::Left).collect();
+        assert!(left.len() >= 12, "{} left seeds", left.len());
+        for s in left {
+            let i = s.point as usize;
+            assert!((y[i] - 8.0).abs() <= 0.1, "seed at y = {:.3}", y[i]);
+        }
     }
 
     #[test]
