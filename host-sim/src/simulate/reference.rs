@@ -97,9 +97,13 @@ impl Visibility {
         }
         let pos = a[v] + (a[v + 1] - a[v]) * tc.t;
         let b = ((pos / BIN_M) as usize).min(self.road[ti].len() - 1);
-        if (-BAND_M..-0.003).contains(&tc.s) {
+        // The side is the surface the true hit lies on (`ground`: road for s ≤ 0, the curb's
+        // face, top or ramp for s > 0). The face's foot counts: a ring meeting a face at a
+        // shallow elevation climbs it slowly along the toe, and its lowest face returns are
+        // the only curb-side ones beside its road returns.
+        if (-BAND_M..0.0).contains(&tc.s) {
             self.road[ti][b] += 1;
-        } else if tc.s > 0.003 && tc.s <= BAND_M {
+        } else if tc.s > 0.0 && tc.s <= BAND_M {
             self.curb[ti][b] += 1;
         }
     }
@@ -262,7 +266,47 @@ pub fn reference_lines(
 
 #[cfg(test)]
 mod tests {
-    use super::join_gaps;
+    use super::{join_gaps, Visibility, BIN_M};
+    use crate::simulate::ground::ToeCoord;
+
+    /// No evidence yet on one straight toe 2 m long, vertices every 0.25 m, not joined.
+    fn straight_toe() -> Visibility {
+        let along: Vec<f64> = (0..9).map(|i| i as f64 * 0.25).collect();
+        let bins = (2.0 / BIN_M) as usize + 2;
+        Visibility {
+            along: vec![along],
+            road: vec![vec![0; bins]],
+            curb: vec![vec![0; bins]],
+            join_m: 0.0,
+        }
+    }
+
+    /// Vertex 4's window holding one return at each signed distance `s` from the toe.
+    fn kept_with(s: &[f64]) -> bool {
+        let mut v = straight_toe();
+        for &s in s {
+            v.add(&ToeCoord {
+                toe: 0,
+                vtx: 4,
+                t: 0.1,
+                s,
+            });
+        }
+        v.kept(0)[4]
+    }
+
+    #[test]
+    fn a_return_on_the_faces_foot_is_curb_side_evidence() {
+        // A road return and one 1 cm up the face (s = 1 mm at a batter of 0.1), as a ring
+        // leaves where it starts to climb the face.
+        assert!(kept_with(&[-0.05, 0.001]));
+        // The road's last millimetre before the toe is the road side.
+        assert!(kept_with(&[-0.001, 0.05]));
+        // One side alone is not enough, nor a return beyond the band.
+        assert!(!kept_with(&[-0.05, -0.001]));
+        assert!(!kept_with(&[0.001, 0.05]));
+        assert!(!kept_with(&[-0.05, 0.2]));
+    }
 
     /// Vertices every 0.1 m; `holes` are `(first, end)` index ranges left unobserved.
     fn joined(holes: &[(usize, usize)], join_m: f64) -> Vec<bool> {
