@@ -145,7 +145,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 section_m: args.section_m,
                 margin_m: args.margin_m,
                 max_s: args.window_max_s,
-                ..WindowParams::default()
             };
             stream::extract(&args.points, trajectory, &cfg, &opts, &window, &progress)?
         }

@@ -425,8 +425,6 @@ pub(super) fn stage_window(window: &WindowParams, cfg: &Config, rings: bool) -> 
             } else {
                 0.0
             },
-        // The arcs' reach is the rings' lead.
-        lead_max_m: if rings { 0.0 } else { window.lead_max_m },
         ..*window
     }
 }

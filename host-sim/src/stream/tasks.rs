@@ -59,11 +59,7 @@ pub struct TaskOutput {
 pub fn plan(traj: &Trajectory, window: &WindowParams, tasks: usize) -> Vec<TaskSpec> {
     let route = Route::new(traj);
     let l = window.section_m.max(1.0);
-    // A task reads as far as its window's margin may grow with the points' lead.
-    let m = window
-        .margin_m
-        .max(0.0)
-        .max(window.lead_max_m.max(0.0) + super::window::LEAD_REACH_M);
+    let m = window.margin_m.max(0.0);
     let length = route.length_m();
     // `SectionWindow` runs sections 0, 1, … while k·l ≤ the route's length.
     let sections = if l > length {

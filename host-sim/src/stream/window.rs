@@ -47,12 +47,6 @@ pub struct WindowParams {
     /// window closes the section at the vehicle's station and drops the oldest points it
     /// still holds (counted), so memory is bounded by this span times the point rate.
     pub max_s: f64,
-    /// Most the window widens the margin by for the lead of the points, metres: a mount
-    /// yawed from across the road measures a curb `l` metres aside `l · tan(yaw)` ahead of
-    /// or behind the vehicle, more than `margin_m` on side-street legs. The window measures
-    /// that lead on the points it takes in ([`SectionWindow::lead_m`]) and holds at least
-    /// the lead plus a track's reach either side of a section, up to this much more road.
-    pub lead_max_m: f64,
 }
 
 impl Default for WindowParams {
@@ -61,7 +55,6 @@ impl Default for WindowParams {
             section_m: 60.0,
             margin_m: 10.0,
             max_s: 20.0,
-            lead_max_m: 30.0,
         }
     }
 }
@@ -156,9 +149,6 @@ pub struct SectionWindow<'a> {
     pub peak_points: usize,
     /// Points dropped by the time cap (`max_s`).
     pub capped_points: u64,
-    /// Farthest a point within [`LEAD_ASIDE_M`] of the vehicle lay ahead of or behind it
-    /// when measured, metres, over the points taken in so far (one in [`LEAD_STRIDE`]).
-    pub lead_m: f64,
     /// The point grid of the section last run, slid on to the next (its slabs of the
     /// margin they share are kept).
     grid: PointGrid,
@@ -169,17 +159,6 @@ pub struct SectionWindow<'a> {
 /// Least progress along the route, metres, for which the time cap closes a section early;
 /// below it (a standing vehicle) the cap only drops the oldest points.
 const CAP_MIN_SECTION_M: f64 = 1.0;
-
-/// Farthest aside of the vehicle a point counts for the window's lead, metres: the side
-/// streets' legs a track follows lie within it.
-const LEAD_ASIDE_M: f64 = 30.0;
-
-/// Road a track and the post-filters reach from the points beside it, metres, held beyond
-/// the lead.
-pub(super) const LEAD_REACH_M: f64 = 5.0;
-
-/// One point in this many counts for the window's lead.
-const LEAD_STRIDE: usize = 16;
 
 impl<'a> SectionWindow<'a> {
     /// A window over `traj`'s route.
@@ -196,7 +175,6 @@ impl<'a> SectionWindow<'a> {
             kept: Vec::new(),
             peak_points: 0,
             capped_points: 0,
-            lead_m: 0.0,
             grid: PointGrid::build(&[], &[], 1.0, |_| false),
             finish_threads: 1,
         }
@@ -239,35 +217,8 @@ impl<'a> SectionWindow<'a> {
         self.params.section_m.max(1.0)
     }
 
-    /// The margin: `margin_m`, or the points' lead (at most `lead_max_m`) and a track's
-    /// reach where that is more.
     fn margin_m(&self) -> f64 {
-        let m = self.params.margin_m.max(0.0);
-        let lead = self.lead_m.min(self.params.lead_max_m.max(0.0));
-        if lead > 0.0 {
-            m.max(lead + LEAD_REACH_M)
-        } else {
-            m
-        }
-    }
-
-    /// Raises [`lead_m`](Self::lead_m) to the farthest that one in [`LEAD_STRIDE`] of the
-    /// batch's points within [`LEAD_ASIDE_M`] of the vehicle lies ahead of or behind it.
-    fn measure_lead(&mut self, b: &CoreBatch) {
-        let s = b.skip.min(b.t.len());
-        let n = b.t.len().min(b.x.len()).min(b.y.len());
-        for i in (s..n).step_by(LEAD_STRIDE) {
-            let Some(p) = self.traj.pose_at(b.t[i]) else {
-                continue;
-            };
-            let h = p.heading_deg.to_radians();
-            let (dx, dy) = (b.x[i] - p.x, b.y[i] - p.y);
-            let ahead = dx * h.sin() + dy * h.cos();
-            let aside = dx * h.cos() - dy * h.sin();
-            if aside.abs() <= LEAD_ASIDE_M && ahead.is_finite() {
-                self.lead_m = self.lead_m.max(ahead.abs());
-            }
-        }
+        self.params.margin_m.max(0.0)
     }
 
     fn station(&self, t: f64) -> f64 {
@@ -281,9 +232,6 @@ impl<'a> SectionWindow<'a> {
 
     /// Takes the core's output for the next points and runs every section they complete.
     pub fn push(&mut self, b: CoreBatch) -> Vec<EdgeLine> {
-        if self.params.lead_max_m > 0.0 {
-            self.measure_lead(&b);
-        }
         self.cols.append(b);
         self.peak_points = self.peak_points.max(self.cols.len());
         let mut out = Vec::new();
@@ -624,40 +572,5 @@ mod tests {
         let open = drive(f64::INFINITY);
         assert!(open.peak_points >= 200 * 20_000, "{}", open.peak_points);
         assert_eq!(open.capped_points, 0);
-    }
-
-    /// One second of the drive of `stop_and_go` from `t0` (before its stop): points `ahead`
-    /// metres ahead of the vehicle and `aside` metres to its left.
-    fn seen_ahead(t0: f64, ahead: f64, aside: f64) -> CoreBatch {
-        let mut b = second(0, t0);
-        b.x = b.t.iter().map(|&t| 10.0 * t + ahead).collect();
-        b.y = vec![aside; b.t.len()];
-        b
-    }
-
-    #[test]
-    fn the_margin_holds_points_measured_far_ahead_of_where_they_lie() {
-        let traj = stop_and_go();
-        let mut w = SectionWindow::new(&traj, WindowParams::default(), BendParams::default());
-        assert_eq!(w.margin_m(), 10.0);
-        // A yawed mount sees a side street's leg 20 m aside 25 m ahead: the window holds
-        // that lead and a track's reach either side of a section.
-        w.push(seen_ahead(0.0, 25.0, 20.0));
-        assert!((w.lead_m - 25.0).abs() < 0.2, "{}", w.lead_m);
-        assert!((w.margin_m() - 30.0).abs() < 0.2, "{}", w.margin_m());
-        // Points farther aside do not count, and the lead is capped.
-        let mut far = SectionWindow::new(&traj, WindowParams::default(), BendParams::default());
-        far.push(seen_ahead(0.0, 25.0, 40.0));
-        assert_eq!(far.margin_m(), 10.0);
-        far.push(seen_ahead(1.0, -80.0, 5.0));
-        assert!((far.margin_m() - 35.0).abs() < 1e-9, "{}", far.margin_m());
-        // Without a lead allowance the margin is `margin_m`.
-        let params = WindowParams {
-            lead_max_m: 0.0,
-            ..WindowParams::default()
-        };
-        let mut off = SectionWindow::new(&traj, params, BendParams::default());
-        off.push(seen_ahead(0.0, 25.0, 20.0));
-        assert_eq!(off.margin_m(), 10.0);
     }
 }
