@@ -209,4 +209,6 @@ pub fn median(v: &mut [f64]) -> Option<f64> {
 }
 
 #[cfg(test)]
+mod fixture;
+#[cfg(test)]
 mod tests;

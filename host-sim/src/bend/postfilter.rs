@@ -668,6 +668,7 @@ pub fn category_runs(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bend::fixture::KeptPoints;
     use crate::model::Side;
 
     #[test]
@@ -809,22 +810,10 @@ mod tests {
                 });
             }
         }
-        let n = x.len();
-        let (t, rho) = (vec![0.0; n], vec![0.0f32; n]);
-        let status = vec![Some(PointStatus::Kept); n];
+        let points = KeptPoints::new(x, y, z);
         let traj = Trajectory::default();
-        let input = BendInput {
-            x: &x,
-            y: &y,
-            z: &z,
-            t: &t,
-            rho_deg: &rho,
-            status: &status,
-            scanline: &vec![0; n],
-            candidates: &[],
-            trajectory: &traj,
-        };
-        let grid = PointGrid::build(&x, &y, 0.1, |_| true);
+        let input = points.input(&traj);
+        let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
         let along = |row: i32| {
             let k = rows.iter().position(|&r| r == row).unwrap() as u32 * 101;
             Track::measured(&input, (k..k + 101).collect(), Side::Left)

@@ -512,6 +512,7 @@ impl Profile<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bend::fixture::KeptPoints;
     use crate::io::trajectory::Trajectory;
 
     /// The toe on a profile across a curb along y at x = 0 (0.15 m up towards +x, the
@@ -527,23 +528,10 @@ mod tests {
                 z.push(if px < 0.0 { road(px) } else { 0.15 + 0.02 * px });
             }
         }
-        let n = x.len();
-        let (t, rho) = (vec![0.0; n], vec![0.0f32; n]);
-        let status = vec![Some(PointStatus::Kept); n];
-        let scanline = vec![0u32; n];
+        let points = KeptPoints::new(x, y, z);
         let trajectory = Trajectory::default();
-        let input = BendInput {
-            x: &x,
-            y: &y,
-            z: &z,
-            t: &t,
-            rho_deg: &rho,
-            status: &status,
-            scanline: &scanline,
-            candidates: &[],
-            trajectory: &trajectory,
-        };
-        let grid = PointGrid::build(&x, &y, 0.1, |_| true);
+        let input = points.input(&trajectory);
+        let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
         // Walking along +y with the curb on the right (+x).
         Profile {
             input: &input,

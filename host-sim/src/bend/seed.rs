@@ -379,6 +379,7 @@ pub fn ransac_line(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bend::fixture::KeptPoints;
 
     /// 30 points on y = 0.5·x + 3 (x from 0 to 2.9 m, far from the origin), every third
     /// one moved 0.3–1.2 m off the line.
@@ -451,9 +452,10 @@ mod tests {
                 py += 0.45;
             }
         }
-        let n = x.len();
-        let (rho, scanline) = (vec![0.0f32; n], vec![0u32; n]);
-        let status = vec![Some(crate::replay::PointStatus::Kept); n];
+        let points = KeptPoints {
+            t,
+            ..KeptPoints::new(x, y, z)
+        };
         let samples = (-10..=40)
             .map(|k| Pose {
                 t: T0 + 0.1 * f64::from(k),
@@ -466,19 +468,9 @@ mod tests {
             })
             .collect();
         let trajectory = Trajectory { samples };
-        let input = BendInput {
-            x: &x,
-            y: &y,
-            z: &z,
-            t: &t,
-            rho_deg: &rho,
-            status: &status,
-            scanline: &scanline,
-            candidates: &[],
-            trajectory: &trajectory,
-        };
+        let input = points.input(&trajectory);
         let params = BendParams::default();
-        let grid = PointGrid::build(&x, &y, params.search_radius_m, |_| true);
+        let grid = PointGrid::build(input.x, input.y, params.search_radius_m, |_| true);
         let route = Route::new(&trajectory);
         // Neither the default nor the widened profiles find the toe anywhere.
         let half_l = 2.0 * params.profile_half_length_m;
@@ -504,7 +496,11 @@ mod tests {
         assert!(left.len() >= 12, "{} left seeds", left.len());
         for s in left {
             let i = s.point as usize;
-            assert!((y[i] - 8.0).abs() <= 0.1, "seed at y = {:.3}", y[i]);
+            assert!(
+                (input.y[i] - 8.0).abs() <= 0.1,
+                "seed at y = {:.3}",
+                input.y[i]
+            );
         }
     }
 

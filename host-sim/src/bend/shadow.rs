@@ -80,9 +80,9 @@ pub fn place_shadowed_toes(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bend::fixture::KeptPoints;
     use crate::io::trajectory::{Pose, Trajectory};
     use crate::model::Side;
-    use crate::replay::PointStatus;
 
     /// A curb along y with its toe at x = 0 (road x < 0 at z 0, sidewalk 0.12 m up),
     /// scanned by lines along y, one every 0.05 m across; no road returns in the
@@ -104,9 +104,12 @@ mod tests {
             }
         }
         let n = x.len();
-        let status = vec![Some(PointStatus::Kept); n];
-        let rho = vec![0.0f32; n];
         let t: Vec<f64> = (0..n).map(|i| i as f64 * 1e-4).collect();
+        let kept = KeptPoints {
+            t,
+            scanline: line,
+            ..KeptPoints::new(x, y, z)
+        };
         let pose = |t: f64| Pose {
             t,
             x: scanner_x,
@@ -119,17 +122,7 @@ mod tests {
         let trajectory = Trajectory {
             samples: vec![pose(-1.0), pose(10.0)],
         };
-        let input = BendInput {
-            x: &x,
-            y: &y,
-            z: &z,
-            t: &t,
-            rho_deg: &rho,
-            status: &status,
-            scanline: &line,
-            candidates: &[],
-            trajectory: &trajectory,
-        };
+        let input = kept.input(&trajectory);
         let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
         let xyz: Vec<[f64; 3]> = (0..6)
             .map(|k| [-0.12, -0.5 + 0.15 * k as f64, 0.0])
