@@ -136,8 +136,7 @@ pub fn profile_seeds(
     if reach.is_nan() || reach < PROFILE_SEED_NEAR_M {
         return out;
     }
-    let finite_t = || input.t.iter().copied().filter(|t| t.is_finite());
-    let (Some(t0), Some(t1)) = (finite_t().reduce(f64::min), finite_t().reduce(f64::max)) else {
+    let Some((t0, t1)) = finite_range(input.t) else {
         return out;
     };
     let (Some(s0), Some(s1)) = (route.arc_at(t0), route.arc_at(t1)) else {
@@ -166,8 +165,10 @@ pub fn profile_seeds(
             .flat_map_iter(|&l| sides.iter().map(move |&s| (l, s)))
             .filter_map(|((interval, p, fwd), (side, up))| {
                 let n = [-fwd[1] * up, fwd[0] * up];
-                let first = |params: &BendParams, half_l: f64| {
-                    first_toe_outward(input, grid, p, fwd, n, up, half_l, reach, params)
+                let mut heights = Heights::new(params.profile_half_width_m);
+                let mut first = |params: &BendParams, half_l: f64| {
+                    let h = &mut heights;
+                    first_toe_outward(input, grid, p, fwd, n, up, half_l, reach, params, h)
                 };
                 first(params, half_l)
                     .or_else(|| first(&wide, half_l))
@@ -184,10 +185,62 @@ pub fn profile_seeds(
     out
 }
 
+/// The smallest and the largest finite value of `t`, `None` where none is finite.
+fn finite_range(t: &[f64]) -> Option<(f64, f64)> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &v in t {
+        if v.is_finite() {
+            lo = if v < lo { v } else { lo };
+            hi = if v > hi { v } else { hi };
+        }
+    }
+    (lo <= hi).then_some((lo, hi))
+}
+
+/// The ground heights ([`ground_height`]) at the centres of one side's outward search,
+/// kept for the searches after it: the centres are the same in every search, and the
+/// profiles of the default width and the longer ones take their heights over the same
+/// radius (`r`); a search of another radius (the widened profiles') computes its own.
+struct Heights {
+    r: f64,
+    /// By centre, counted outward: `None` where not yet computed.
+    z: Vec<Option<Option<f64>>>,
+    /// The heights within the radius, kept from one centre to the next.
+    scratch: Vec<f64>,
+}
+
+impl Heights {
+    fn new(r: f64) -> Self {
+        Self {
+            r,
+            z: Vec::new(),
+            scratch: Vec::new(),
+        }
+    }
+
+    /// [`ground_height`] at centre `k` (counted outward) within `r` of `centre`.
+    fn at(
+        &mut self,
+        k: usize,
+        input: &BendInput,
+        grid: &PointGrid,
+        centre: [f64; 2],
+        r: f64,
+    ) -> Option<f64> {
+        if r.to_bits() != self.r.to_bits() {
+            return ground_height(input, grid, centre, r, &mut self.scratch);
+        }
+        if self.z.len() <= k {
+            self.z.resize(k + 1, None);
+        }
+        *self.z[k].get_or_insert_with(|| ground_height(input, grid, centre, r, &mut self.scratch))
+    }
+}
+
 /// The seed point of the first toe that profiles across `fwd` find outward along `n` from
 /// `p`, from [`PROFILE_SEED_NEAR_M`] to `reach` every [`PROFILE_SEED_STEP_M`] (see
 /// [`profile_seeds`]): the usable point nearest to it; `None` where the first toe has none
-/// within the search radius, or there is no toe.
+/// within the search radius, or there is no toe. The ground heights come from `heights`.
 #[allow(clippy::too_many_arguments)]
 fn first_toe_outward(
     input: &BendInput,
@@ -199,12 +252,15 @@ fn first_toe_outward(
     half_l: f64,
     reach: f64,
     params: &BendParams,
+    heights: &mut Heights,
 ) -> Option<u32> {
     let mut c = PROFILE_SEED_NEAR_M;
+    let mut k = 0;
     while c <= reach {
         let centre = [p[0] + c * n[0], p[1] + c * n[1]];
         c += PROFILE_SEED_STEP_M;
-        let Some(z) = ground_height(input, grid, centre, params.profile_half_width_m) else {
+        k += 1;
+        let Some(z) = heights.at(k - 1, input, grid, centre, params.profile_half_width_m) else {
             continue;
         };
         let at = [centre[0], centre[1], z];
@@ -226,9 +282,15 @@ fn first_toe_outward(
 }
 
 /// Median height of the usable points within `r` (horizontal) of `centre`; `None` with
-/// fewer than 8 of them.
-fn ground_height(input: &BendInput, grid: &PointGrid, centre: [f64; 2], r: f64) -> Option<f64> {
-    let mut z: Vec<f64> = Vec::new();
+/// fewer than 8 of them. The heights are gathered in `z`.
+fn ground_height(
+    input: &BendInput,
+    grid: &PointGrid,
+    centre: [f64; 2],
+    r: f64,
+    z: &mut Vec<f64>,
+) -> Option<f64> {
+    z.clear();
     grid.for_each_within(input.x, input.y, centre[0], centre[1], r, |i| {
         if usable(input, i) && input.z[i].is_finite() {
             z.push(input.z[i]);
@@ -487,6 +549,7 @@ mod tests {
                     half_l,
                     15.0,
                     p,
+                    &mut Heights::new(params.profile_half_width_m),
                 );
                 assert_eq!(toe, None, "a toe at {at:?}");
             }
