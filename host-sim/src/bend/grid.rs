@@ -296,10 +296,12 @@ impl Slab {
         for (i, (&px, &py)) in x.iter().zip(y).enumerate() {
             if px.is_finite() && py.is_finite() && keep(i) {
                 kept[i >> 6] |= 1 << (i & 63);
-                x0 = x0.min(px);
-                y0 = y0.min(py);
-                x1 = x1.max(px);
-                y1 = y1.max(py);
+                // Finite values: a comparison and a select (one instruction each on
+                // x86-64), where `f64::min` and `max` also handle NaN.
+                x0 = if px < x0 { px } else { x0 };
+                y0 = if py < y0 { py } else { y0 };
+                x1 = if px > x1 { px } else { x1 };
+                y1 = if py > y1 { py } else { y1 };
                 count += 1;
             }
         }
