@@ -13,6 +13,8 @@ pub struct Route {
     y: Vec<f64>,
     s: Vec<f64>,
     heading_deg: Vec<f64>,
+    /// Whether every sample's position is finite.
+    finite: bool,
     /// Decimated vertices (indices into the columns above) for nearest-point queries.
     grid: PointGrid,
 }
@@ -30,6 +32,7 @@ impl Route {
             y: Vec::with_capacity(n),
             s: Vec::with_capacity(n),
             heading_deg: Vec::with_capacity(n),
+            finite: true,
             grid: PointGrid::build(&[], &[], 1.0, |_| true),
         };
         let mut s = 0.0;
@@ -42,6 +45,7 @@ impl Route {
             r.y.push(p.y);
             r.s.push(s);
             r.heading_deg.push(p.heading_deg);
+            r.finite &= p.x.is_finite() && p.y.is_finite();
         }
         // Keep a vertex every DECIMATE_M (and the last one) for the nearest-point index.
         let mut keep = vec![false; n];
@@ -126,9 +130,9 @@ impl Route {
     /// Arc length of the nearest point of the route to `(px, py)`, metres, or `None` for
     /// an empty route.
     pub fn station_near(&self, px: f64, py: f64) -> Option<f64> {
-        let (q, _) = self.nearest(px, py)?;
+        let (q, _, on) = self.nearest_on(px, py)?;
         // The nearest point lies on a segment of the original samples: find it by position.
-        let k = self.segment_near(q)?;
+        let k = self.segment_near(q, on)?;
         let next = (k + 1).min(self.s.len() - 1);
         let l = (self.x[next] - self.x[k]).hypot(self.y[next] - self.y[k]);
         let u = if l > 0.0 {
@@ -140,8 +144,14 @@ impl Route {
     }
 
     /// The route segment (index of its first sample) passing closest to `q`, searched among
-    /// the samples within 4 m (of arc) of the nearest kept vertex.
-    fn segment_near(&self, q: [f64; 2]) -> Option<usize> {
+    /// the samples within 4 m (of arc) of the nearest kept vertex, the first on ties.
+    ///
+    /// Segment `hint`, where one is known to lie near `q`, bounds the search: a segment
+    /// whose box lies farther from `q` along x or y than the hint's offset (the sum of its
+    /// components, plus [`SEGMENT_SLACK`] of the coordinates, far above their rounding)
+    /// is neither nearer than the hint nor tied with it, so it is passed over without its
+    /// offset; the segment found is the one the whole search finds.
+    fn segment_near(&self, q: [f64; 2], hint: usize) -> Option<usize> {
         let mut best: Option<([f64; 2], usize)> = None;
         let mut r = 2.0 * DECIMATE_M;
         while best.is_none() && r < 1e7 {
@@ -161,8 +171,7 @@ impl Route {
             .s
             .partition_point(|&s| s <= s0 + 4.0)
             .min(self.s.len() - 1);
-        let mut out: Option<([f64; 2], usize)> = None;
-        for k in lo..=hi {
+        let offset = |k: usize| {
             let e = (k + 1).min(self.s.len() - 1);
             let (ax, ay, dx, dy) = (
                 self.x[k],
@@ -176,7 +185,35 @@ impl Route {
             } else {
                 0.0
             };
-            let d = [ax + u * dx - q[0], ay + u * dy - q[1]];
+            [ax + u * dx - q[0], ay + u * dy - q[1]]
+        };
+        // Beyond `bound` along an axis no segment can win (no bound unless the route and
+        // the hint's offset are finite: a NaN offset is kept where it comes first).
+        let bound = if self.finite && (lo..=hi).contains(&hint) {
+            let d = offset(hint);
+            let b = d[0].abs() + d[1].abs() + SEGMENT_SLACK * (q[0].abs() + q[1].abs() + 1.0);
+            if b.is_finite() {
+                b
+            } else {
+                f64::INFINITY
+            }
+        } else {
+            f64::INFINITY
+        };
+        let mut out: Option<([f64; 2], usize)> = None;
+        for k in lo..=hi {
+            let e = (k + 1).min(self.s.len() - 1);
+            let (xa, xb, ya, yb) = (self.x[k], self.x[e], self.y[k], self.y[e]);
+            let (x_lo, x_hi) = if xa < xb { (xa, xb) } else { (xb, xa) };
+            let (y_lo, y_hi) = if ya < yb { (ya, yb) } else { (yb, ya) };
+            if x_lo - q[0] > bound
+                || q[0] - x_hi > bound
+                || y_lo - q[1] > bound
+                || q[1] - y_hi > bound
+            {
+                continue;
+            }
+            let d = offset(k);
             if out.is_none_or(|(bd, _)| shorter(d, bd) == Some(Ordering::Less)) {
                 out = Some((d, k));
             }
@@ -192,6 +229,12 @@ impl Route {
     /// The nearest point of the route polyline to `(px, py)` and the forward unit vector
     /// there, or `None` for an empty route.
     pub fn nearest(&self, px: f64, py: f64) -> Option<([f64; 2], [f64; 2])> {
+        self.nearest_on(px, py).map(|(q, fwd, _)| (q, fwd))
+    }
+
+    /// [`Route::nearest`], with the index of the sample that begins the segment the point
+    /// lies on.
+    fn nearest_on(&self, px: f64, py: f64) -> Option<([f64; 2], [f64; 2], usize)> {
         if self.t.is_empty() {
             return None;
         }
@@ -237,9 +280,13 @@ impl Route {
             }
         }
         let h = self.heading_deg[best_p.2].to_radians();
-        Some((best_p.0, [h.sin(), h.cos()]))
+        Some((best_p.0, [h.sin(), h.cos()], best_p.2))
     }
 }
+
+/// Margin of [`Route::segment_near`]'s bound, relative to the coordinates' magnitude:
+/// far above their rounding.
+const SEGMENT_SLACK: f64 = 1e-9;
 
 /// Squared lengths closer than this (relative) are compared by `hypot` itself.
 const SQUARED_TIE: f64 = 1e-9;
