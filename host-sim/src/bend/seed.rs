@@ -206,7 +206,7 @@ struct Heights {
     /// By centre, counted outward: `None` where not yet computed.
     z: Vec<Option<Option<f64>>>,
     /// The heights within the radius, kept from one centre to the next.
-    scratch: Vec<f64>,
+    scratch: Vec<i64>,
 }
 
 impl Heights {
@@ -282,25 +282,38 @@ fn first_toe_outward(
 }
 
 /// Median height of the usable points within `r` (horizontal) of `centre`; `None` with
-/// fewer than 8 of them. The heights are gathered in `z`.
+/// fewer than 8 of them. The heights are gathered in `z` as [`total_order`] keys.
 fn ground_height(
     input: &BendInput,
     grid: &PointGrid,
     centre: [f64; 2],
     r: f64,
-    z: &mut Vec<f64>,
+    z: &mut Vec<i64>,
 ) -> Option<f64> {
     z.clear();
     grid.for_each_within(input.x, input.y, centre[0], centre[1], r, |i| {
         if usable(input, i) && input.z[i].is_finite() {
-            z.push(input.z[i]);
+            z.push(total_order(input.z[i]));
         }
     });
     if z.len() < 8 {
         return None;
     }
     let k = z.len() / 2;
-    Some(*z.select_nth_unstable_by(k, f64::total_cmp).1)
+    Some(from_total_order(*z.select_nth_unstable(k).1))
+}
+
+/// The key of `v` whose integer order is `f64::total_cmp`'s (the key `total_cmp` itself
+/// compares): the k-th key is the k-th height's, and keys compare in one instruction.
+fn total_order(v: f64) -> i64 {
+    let b = v.to_bits() as i64;
+    b ^ (((b >> 63) as u64) >> 1) as i64
+}
+
+/// The height whose [`total_order`] key is `k` (the map is its own inverse: it keeps the
+/// sign bit that decides it).
+fn from_total_order(k: i64) -> f64 {
+    f64::from_bits(total_order(f64::from_bits(k as u64)) as u64)
 }
 
 /// The usable point nearest (horizontally) to `at` within `r`, lowest index on ties.
@@ -564,6 +577,32 @@ mod tests {
                 "seed at y = {:.3}",
                 input.y[i]
             );
+        }
+    }
+
+    #[test]
+    fn total_order_keys_order_heights_as_total_cmp() {
+        let v = [
+            -f64::INFINITY,
+            -1.5,
+            -f64::MIN_POSITIVE,
+            -0.0,
+            0.0,
+            5e-324,
+            0.25,
+            0.25 + f64::EPSILON,
+            3.0e8,
+            f64::INFINITY,
+        ];
+        for a in v {
+            assert_eq!(from_total_order(total_order(a)).to_bits(), a.to_bits());
+            for b in v {
+                assert_eq!(
+                    total_order(a).cmp(&total_order(b)),
+                    a.total_cmp(&b),
+                    "{a} {b}"
+                );
+            }
         }
     }
 
