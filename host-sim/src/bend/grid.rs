@@ -426,102 +426,23 @@ impl Slab {
             return;
         };
         let r2 = r * r;
-        // No cell lies wholly inside a disc narrower than a cell's diagonal.
-        let inner = 2.0 * r2 >= self.cell_m * self.cell_m;
-        let slack = INNER_SLACK_M + INNER_SLACK_REL * (px.abs() + py.abs());
         for cy in ay..=by {
             let row = cy * self.nx;
             let (lo, hi) = (
                 self.starts[row + ax] as usize,
                 self.starts[row + bx + 1] as usize,
             );
-            let cells = if inner {
-                self.inner_cells(cy, px, py, r2, slack)
-            } else {
-                None
-            };
-            // The row's points: those of the inner cells `m0..m1` untested, the others
-            // tested, in the row's order.
-            let (m0, m1) = match cells {
-                Some((c0, c1)) if c0.max(ax) <= c1.min(bx) => (
-                    self.starts[row + c0.max(ax)] as usize,
-                    self.starts[row + c1.min(bx) + 1] as usize,
-                ),
-                _ => (hi, hi),
-            };
-            for (a, b, test) in [(lo, m0, true), (m0, m1, false), (m1, hi, true)] {
-                if !test {
-                    for &i in &self.order[a..b] {
-                        f(i as usize);
-                    }
-                    continue;
-                }
-                for &i in &self.order[a..b] {
-                    let i = i as usize;
-                    let dx = x[i] - px;
-                    let dy = y[i] - py;
-                    if dx * dx + dy * dy <= r2 {
-                        f(i);
-                    }
+            for &i in &self.order[lo..hi] {
+                let i = i as usize;
+                let dx = x[i] - px;
+                let dy = y[i] - py;
+                if dx * dx + dy * dy <= r2 {
+                    f(i);
                 }
             }
         }
-    }
-
-    /// The cells `c0..=c1` of row `cy` whose points all pass the distance test of a disc
-    /// of squared radius `r2` around `(px, py)`: the cells that lie, `slack` wider on
-    /// every side than their bounds, within the disc shrunk by [`INNER_MARGIN`]. A point
-    /// lies inside its cell's bounds up to its coordinates' rounding, far below `slack`,
-    /// and the test's own rounding is far below the margin, so the test can be skipped
-    /// for these cells' points.
-    fn inner_cells(
-        &self,
-        cy: usize,
-        px: f64,
-        py: f64,
-        r2: f64,
-        slack: f64,
-    ) -> Option<(usize, usize)> {
-        let cell = self.cell_m;
-        let band0 = self.y0 + cy as f64 * cell - slack;
-        let band1 = self.y0 + (cy + 1) as f64 * cell + slack;
-        let dy = (band0 - py).abs().max((band1 - py).abs());
-        let h2 = r2 * (1.0 - INNER_MARGIN) - dy * dy;
-        if !(h2 > 0.0 && h2.is_finite()) {
-            return None;
-        }
-        let h = h2.sqrt();
-        let (left, right) = (px - h, px + h);
-        // First and last cell from the quotients, then checked against the bounds
-        // themselves, so the quotients' rounding cannot take in a cell that sticks out.
-        let a = floor((left + slack - self.x0) / cell) + 1.0;
-        let b = floor((right - slack - self.x0) / cell) - 1.0;
-        if !(a >= 0.0 && b >= a && b < self.nx as f64) {
-            return None;
-        }
-        let (mut c0, mut c1) = (a as usize, b as usize);
-        while c0 <= c1 && self.x0 + c0 as f64 * cell - slack < left {
-            c0 += 1;
-        }
-        while c1 >= c0 && self.x0 + (c1 + 1) as f64 * cell + slack > right {
-            if c1 == 0 {
-                return None;
-            }
-            c1 -= 1;
-        }
-        (c0 <= c1).then_some((c0, c1))
     }
 }
-
-/// How much wider than their bounds [`Slab::inner_cells`] takes cells, metres, and the
-/// part of the coordinates' magnitude added to it: far above the rounding of a point's
-/// cell and of the cells' bounds.
-const INNER_SLACK_M: f64 = 1e-6;
-const INNER_SLACK_REL: f64 = 1e-12;
-
-/// How much of the squared radius [`Slab::inner_cells`] leaves out, relative: far above
-/// the rounding of the squared offsets the distance test sums.
-const INNER_MARGIN: f64 = 1e-9;
 
 /// A convex quadrilateral (corners in order around it) for row-by-row cell ranges.
 struct Rect {
@@ -862,66 +783,6 @@ mod tests {
                 assert!(want.len() > 50, "{}", want.len());
             }
         }
-    }
-
-    #[test]
-    fn a_disc_query_skipping_inner_cells_is_the_one_testing_every_point() {
-        // A 0.05 m lattice (points exactly on the discs' rims) and a scatter, far from
-        // the origin; discs narrower and wider than the cells, centred on lattice points
-        // and between them.
-        let (x0, y0) = (455_000.0, 3_951_000.0);
-        let (mut x, mut y) = (Vec::new(), Vec::new());
-        for j in 0..60 {
-            for i in 0..60 {
-                x.push(x0 + f64::from(i) * 0.05);
-                y.push(y0 + f64::from(j) * 0.05);
-            }
-        }
-        for k in 0..4_000u32 {
-            x.push(x0 + f64::from(k.wrapping_mul(2_654_435_761) % 3_001) * 1e-3);
-            y.push(y0 + f64::from(k.wrapping_mul(40_503) % 2_903) * 1e-3);
-        }
-        let mut skipped = 0;
-        for cell in [0.1, 0.15] {
-            let g = PointGrid::build(&x, &y, cell, |i| i % 13 != 5);
-            let s = &g.slabs[0];
-            for (q, r) in (0..60u32).zip([0.05, 0.07, 0.2, 0.25, 0.45, 0.6, 1.3].iter().cycle()) {
-                let (px, py) = (
-                    x0 + 0.5 + f64::from(q % 7) * 0.25 + f64::from(q % 2) * 0.013,
-                    y0 + 0.5 + f64::from(q % 5) * 0.3,
-                );
-                let mut got = Vec::new();
-                g.for_each_within(&x, &y, px, py, *r, |i| got.push(i));
-                // Every point of the disc's cells tested, row by row.
-                let mut want = Vec::new();
-                let (ax, bx) = s.span(px - r - s.x0, px + r - s.x0, s.nx).unwrap();
-                let (ay, by) = s.span(py - r - s.y0, py + r - s.y0, s.ny).unwrap();
-                for cy in ay..=by {
-                    let row = cy * s.nx;
-                    let (lo, hi) = (s.starts[row + ax], s.starts[row + bx + 1]);
-                    for &i in &s.order[lo as usize..hi as usize] {
-                        let (dx, dy) = (x[i as usize] - px, y[i as usize] - py);
-                        if dx * dx + dy * dy <= r * r {
-                            want.push(i as usize);
-                        }
-                    }
-                    if 2.0 * r * r >= s.cell_m * s.cell_m
-                        && s.inner_cells(
-                            cy,
-                            px,
-                            py,
-                            r * r,
-                            INNER_SLACK_M + INNER_SLACK_REL * (px + py),
-                        )
-                        .is_some()
-                    {
-                        skipped += 1;
-                    }
-                }
-                assert_eq!(got, want, "cell {cell}, r {r}, ({px}, {py})");
-            }
-        }
-        assert!(skipped > 100, "{skipped} rows with inner cells");
     }
 
     #[test]
