@@ -15,7 +15,6 @@ use crate::replay::{Candidate, PointStatus};
 pub mod bridge;
 pub mod claims;
 pub mod climb;
-pub mod flush;
 pub mod grid;
 pub mod params;
 pub mod postfilter;

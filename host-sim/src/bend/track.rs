@@ -376,53 +376,6 @@ fn cut_on_line(
     (ahead > 0.25 * d_s).then_some((toe, a))
 }
 
-/// Length of curb before a cut that the line of [`flush_on_curb_line`] leaves out, metres:
-/// the longest transition, where the curb's height falls to the lip and the picks of the
-/// low step lie towards the road.
-const FLUSH_SKIP_M: f64 = 1.5;
-
-/// The toe of a flush crossing ([`Profile::flush_toe`]) on the line of the curb before
-/// the cut, placed on that line, with the line's direction; `None` where the track has too
-/// little curb before the cut for a line, or the profile there shows no flush toe.
-///
-/// The line is [`line_ahead`]'s over [`CUT_LINE_M`] of the vertices before the cut's first
-/// toe (`cut_from`; all of them when the track is not on a cut yet), ending
-/// [`FLUSH_SKIP_M`] before the last of them, not over the cut's own toes or its
-/// transition: there the toes lean towards the ramp or the road, and a flush
-/// crossing's break, weak and drawn off the toe by any lip, only confirms that the curb's
-/// line runs on. `long` is the profile the track tried at the search position.
-fn flush_on_curb_line(
-    long: Profile,
-    picked: &[(u32, [f64; 3])],
-    cut_from: Option<usize>,
-    cur: [f64; 3],
-    along: [f64; 2],
-    d_s: f64,
-) -> Option<(ProfileToe, [f64; 2])> {
-    let curb = &picked[..cut_from.unwrap_or(picked.len()).min(picked.len())];
-    let end = curb.last()?.1;
-    // Without the cut's transition, whose low step draws the picks towards the road.
-    let k = curb
-        .iter()
-        .rposition(|v| (v.1[0] - end[0]).hypot(v.1[1] - end[1]) > FLUSH_SKIP_M)?;
-    let (q0, a) = line_ahead(&curb[..=k], curb[k].1, along, 0.0)?;
-    let s = (cur[0] - q0[0]) * a[0] + (cur[1] - q0[1]) * a[1] + d_s;
-    let q = [q0[0] + s * a[0], q0[1] + s * a[1]];
-    let toe = Profile {
-        centre: [q[0], q[1], cur[2]],
-        along: a,
-        ..long
-    }
-    .flush_toe()?;
-    Some((
-        ProfileToe {
-            xyz: [q[0], q[1], toe.xyz[2]],
-            ..toe
-        },
-        a,
-    ))
-}
-
 /// Farthest back from the toe a track brought down from the top edge drops the vertices
 /// it picked above that toe, metres: the few steps of a climb up the face.
 const CLIMB_DROP_M: f64 = 1.0;
@@ -634,24 +587,17 @@ fn track_one_way(
                         // not one step along v: v follows the scatter of the toes before.
                         let line = line_ahead(&picked, cur, along, d_s);
                         let (cc, ca) = line.map_or((c, along), |(p, a)| ([p[0], p[1], cur[2]], a));
-                        let on_line = Profile {
+                        let t = Profile {
                             centre: cc,
                             along: ca,
                             ..long
-                        };
-                        let t = on_line
-                            .cut_toe()
-                            .map(|t| (t, line.map(|(_, a)| a)))
-                            .or_else(|| {
-                                flush_on_curb_line(long, &picked, cut_from, cur, along, d_s)
-                                    .map(|(t, a)| (t, Some(a)))
-                            });
-                        if let Some((_, a)) = t {
+                        }
+                        .cut_toe();
+                        if t.is_some() {
                             cut_run_m += d_s;
                             cut_from.get_or_insert(picked.len());
-                            cut_dir = a;
+                            cut_dir = line.map(|(_, a)| a);
                         }
-                        let t = t.map(|(t, _)| t);
                         t
                     }
                     None => None,
