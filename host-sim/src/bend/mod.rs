@@ -16,6 +16,7 @@ pub mod bridge;
 pub mod claims;
 pub mod climb;
 pub mod grid;
+pub mod leg;
 pub mod params;
 pub mod postfilter;
 pub mod profile;

@@ -11,6 +11,7 @@
 use super::claims::{Claims, Join};
 use super::climb::{climbed_toe, CLIMBED_SHARE};
 use super::grid::PointGrid;
+use super::leg::leg_toe;
 use super::params::{widened, BendParams};
 use super::profile::{usable, Profile, ProfileToe};
 use super::seed::Seed;
@@ -552,7 +553,8 @@ fn track_one_way(
                 let l = params.profile_half_length_m;
                 // A track along the road tries a wider profile next (a far curb crossed at
                 // a grazing angle). Where the scanlines run along the curb, each at one
-                // offset across the profile, the step between their levels shows the toe.
+                // offset across the profile, the step between their levels shows the toe;
+                // where the returns are sparse (a side street's far leg), a longer profile.
                 let profile = Profile {
                     input,
                     grid,
@@ -570,7 +572,8 @@ fn track_one_way(
                             .then(|| wide_toe(long))
                             .flatten()
                     })
-                    .or_else(|| sparse_toe(&long, &picked));
+                    .or_else(|| sparse_toe(&long, &picked))
+                    .or_else(|| leg_toe(&profile, &picked));
                 // Neither ρ nor a step: a curb cut's toe continues the curb's line as a
                 // break of slope, followed for at most `cut_follow_max_m`, and only by a
                 // track that has followed a curb before it.
