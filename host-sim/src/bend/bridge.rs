@@ -29,6 +29,37 @@ struct End {
     out: [f64; 2],
     /// Length of track the tangent was taken over, metres.
     span: f64,
+    /// Vertices of the track beyond this end (those of a hook left out, see [`unhooked`]).
+    drop: usize,
+    /// The end before the track's hook, when it has one (see [`unhooked`]).
+    inner: Option<Inner>,
+}
+
+/// The end of a track before its last [`END_HOOK_M`]: the vertex, the outward tangent over
+/// [`TANGENT_SPAN_M`] of track before it, that length, and the vertices after it.
+#[derive(Clone, Copy, Debug)]
+struct Inner {
+    xyz: [f64; 3],
+    out: [f64; 2],
+    span: f64,
+    drop: usize,
+}
+
+impl End {
+    /// This end, or the one before the track's hook where it has one.
+    fn unhooked(&self) -> End {
+        match self.inner {
+            Some(i) => End {
+                xyz: i.xyz,
+                out: i.out,
+                span: i.span,
+                drop: i.drop,
+                inner: None,
+                ..*self
+            },
+            None => *self,
+        }
+    }
 }
 
 /// Track length from an end over which its tangent is taken, metres: long enough to average
@@ -69,6 +100,74 @@ fn end_of(t: &Track, track: usize, last: bool) -> Option<End> {
         xyz: e,
         out: [dx / l, dy / l],
         span: along,
+        drop: 0,
+        inner: unhooked(t, last),
+    })
+}
+
+/// Length of track at an end that may hook off the curb's line, metres: where the toe a
+/// track follows fades (a cut's transition lowering the curb), the kernel's peak slides
+/// towards the road over the last few vertices.
+const END_HOOK_M: f64 = 0.5;
+
+/// Least distance of a track's end from the line of the track before [`END_HOOK_M`] for
+/// the end to be a hook, metres: over the toe's own scatter along a track.
+const END_HOOK_MIN_M: f64 = 0.03;
+
+/// Farthest a vertex of the track before the hook may lie from its tangent's line for the
+/// end to be a hook, metres: on a track that wanders by as much (sparse returns, bridged
+/// stretches) an end that does is no hook.
+const END_HOOK_STEADY_M: f64 = 0.03;
+
+/// The end of `t` (its last vertex when `last`) before a hook: the vertex [`END_HOOK_M`]
+/// back from the end with its outward tangent over [`TANGENT_SPAN_M`] of track, when the
+/// end lies at least [`END_HOOK_MIN_M`] off that tangent's line; `None` when the end does
+/// not hook or the track is too short to tell.
+///
+/// A bridge from the hook's end with the hook's tangent runs off a straight curb by
+/// as much as the hook and more (its arc turns with the tangent); from the vertex before
+/// the hook it continues the curb's line.
+fn unhooked(t: &Track, last: bool) -> Option<Inner> {
+    let n = t.xyz.len();
+    let at = |k: usize| if last { t.xyz[n - 1 - k] } else { t.xyz[k] };
+    let mut along = 0.0;
+    let mut k = 0;
+    while along < END_HOOK_M {
+        k += 1;
+        if k >= n {
+            return None;
+        }
+        let (a, b) = (at(k - 1), at(k));
+        along += (b[0] - a[0]).hypot(b[1] - a[1]);
+    }
+    let (e, from) = (at(k), along);
+    let mut far = None;
+    for j in k + 1..n {
+        let (a, b) = (at(j - 1), at(j));
+        along += (b[0] - a[0]).hypot(b[1] - a[1]);
+        far = Some(b);
+        if along - from >= TANGENT_SPAN_M {
+            break;
+        }
+    }
+    let f = far?;
+    let span = along - from;
+    let (dx, dy) = (e[0] - f[0], e[1] - f[1]);
+    let l = dx.hypot(dy);
+    if span < 0.5 * TANGENT_SPAN_M || l <= 1e-6 {
+        return None;
+    }
+    let out = [dx / l, dy / l];
+    let off = |q: [f64; 3]| (out[0] * (q[1] - e[1]) - out[1] * (q[0] - e[0])).abs();
+    let steady = (k..n)
+        .map(at)
+        .take_while(|&q| q != f)
+        .all(|q| off(q) <= END_HOOK_STEADY_M);
+    (steady && off(at(0)) >= END_HOOK_MIN_M).then_some(Inner {
+        xyz: e,
+        out,
+        span,
+        drop: k,
     })
 }
 
@@ -198,9 +297,9 @@ pub fn bridge_tracks(
             .flat_map(|(k, t)| [end_of(t, k, false), end_of(t, k, true)])
             .flatten()
             .collect();
-        let mut best: Option<(f64, f64, usize, usize)> = None;
+        let mut best: Option<(f64, f64, f64, End, End)> = None;
         for (i, a) in ends.iter().enumerate() {
-            for (j, b) in ends.iter().enumerate().skip(i + 1) {
+            for b in ends.iter().skip(i + 1) {
                 let (ta, tb) = (&tracks[a.track], &tracks[b.track]);
                 let (Some(ta), Some(tb)) = (ta, tb) else {
                     continue;
@@ -211,9 +310,16 @@ pub fn bridge_tracks(
                 let Some((d, alpha)) = fit(a, b, params) else {
                     continue;
                 };
-                if best.is_some_and(|(bd, _, _, _)| bd <= d) {
+                if best.is_some_and(|(bd, _, _, _, _)| bd <= d) {
                     continue;
                 }
+                // The bridge runs between the ends before their hooks where those
+                // continue each other too.
+                let (ua, ub) = (a.unhooked(), b.unhooked());
+                let (ua, ub, chord, bulge) = match fit(&ua, &ub, params) {
+                    Some((du, alpha_u)) => (ua, ub, du, alpha_u),
+                    None => (*a, *b, d, alpha),
+                };
                 // No other track may cross the bridge's chord.
                 let (p, q) = ([a.xyz[0], a.xyz[1]], [b.xyz[0], b.xyz[1]]);
                 let blocked = tracks.iter().flatten().any(|t| {
@@ -221,15 +327,14 @@ pub fn bridge_tracks(
                         .windows(2)
                         .any(|w| crosses(p, q, [w[0][0], w[0][1]], [w[1][0], w[1][1]]))
                 });
-                if !blocked && on_ground(input, grid, a.xyz, b.xyz, alpha, d) {
-                    best = Some((d, alpha, i, j));
+                if !blocked && on_ground(input, grid, ua.xyz, ub.xyz, bulge, chord) {
+                    best = Some((d, bulge, chord, ua, ub));
                 }
             }
         }
-        let Some((d, alpha, i, j)) = best else {
+        let Some((_, alpha, d, a, b)) = best else {
             break;
         };
-        let (a, b) = (ends[i], ends[j]);
         let (Some(ta), Some(tb)) = (tracks[a.track].take(), tracks[b.track].take()) else {
             break;
         };
@@ -248,6 +353,8 @@ pub fn bridge_tracks(
         } else {
             b.last
         };
+        av.truncate(av.len() - a.drop);
+        bv.drain(..b.drop);
         let steps = (d / BRIDGE_STEP_M).ceil().max(1.0) as usize;
         for k in 1..steps {
             av.push((
@@ -364,6 +471,29 @@ mod tests {
             .windows(2)
             .all(|w| w[1][0] > w[0][0] && w[1][0] - w[0][0] < 0.151));
         assert!(t.points.iter().any(|&id| id >= 1_000_000));
+    }
+
+    #[test]
+    fn hooked_ends_are_bridged_on_the_curbs_line() {
+        let g = ground(|_, _| false);
+        // A straight curb along y = 5 with 8 m missing (a cut); over the last 0.4 m before
+        // the gap each track slides 5 cm towards the road, as the kernel's peak does where
+        // the curb lowers.
+        let before = line(0.0, 10.0, |x| 5.0 - 0.125 * (x - 9.6).max(0.0), 0);
+        let after = line(18.0, 30.0, |x| 5.0 - 0.125 * (18.4 - x).max(0.0), 100);
+        let out = bridge(&g, vec![before, after]);
+        assert_eq!(out.len(), 1);
+        let t = &out[0];
+        let bridged: Vec<_> = t
+            .points
+            .iter()
+            .zip(&t.xyz)
+            .filter(|(&id, _)| id >= 1_000_000)
+            .collect();
+        assert!(bridged.len() > 50);
+        // The bridge continues the curb's line, and the hooks are left out.
+        assert!(bridged.iter().all(|(_, q)| (q[1] - 5.0).abs() < 1e-6));
+        assert!(t.xyz.iter().all(|q| q[1] > 4.995), "{:?}", t.xyz);
     }
 
     #[test]

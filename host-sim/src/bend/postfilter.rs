@@ -148,6 +148,14 @@ const GAP_SEEN_MIN_POINTS: usize = 3;
 const GAP_TANGENT_VERTICES: usize = 3;
 /// Share of a track's vertices at a gap in the returns from which filter 2b cuts them out.
 const GAP_SHARE: f64 = 0.3;
+/// Length of a run of vertices at a gap in the returns that filter 2b cuts out of a track
+/// under [`GAP_SHARE`], metres: a track that comes off the border of the body's gap onto
+/// a curb (the whole file in one window) carries the border along, too short a share of
+/// it to go by the share alone.
+const GAP_RUN_M: f64 = 2.0;
+/// Most vertices not at a gap that a run of vertices at a gap spans (a vertex whose disc
+/// catches a stray return).
+const GAP_RUN_HOLE: usize = 2;
 
 /// Whether vertex `k` of `t` lies at the edge of a gap in the returns: across the track,
 /// the disc on one side holds no point while the disc on the other side holds some, their
@@ -247,9 +255,49 @@ pub fn remove_at_return_gaps(
         let gap: Vec<bool> = (0..t.xyz.len())
             .map(|k| at_return_gap(input, grid, &t, k, params))
             .collect();
-        keep_unflagged(input, t, &gap, GAP_SHARE, &mut out);
+        let share = gap.iter().filter(|&&g| g).count() as f64 / gap.len().max(1) as f64;
+        if share >= GAP_SHARE {
+            keep_unflagged(input, t, &gap, GAP_SHARE, &mut out);
+            continue;
+        }
+        let runs = long_gap_runs(&t, &gap);
+        if runs.contains(&true) {
+            keep_unflagged(input, t, &runs, 0.0, &mut out);
+        } else {
+            out.push(t);
+        }
     }
     out
+}
+
+/// The vertices of `t` in runs of vertices at a gap (`gap`) of at least [`GAP_RUN_M`],
+/// a run spanning at most [`GAP_RUN_HOLE`] vertices not at a gap between two that are.
+fn long_gap_runs(t: &Track, gap: &[bool]) -> Vec<bool> {
+    let mut runs = vec![false; gap.len()];
+    let mut k = 0;
+    while k < gap.len() {
+        if !gap[k] {
+            k += 1;
+            continue;
+        }
+        let (start, mut end) = (k, k);
+        let mut j = k + 1;
+        while j < gap.len() && j - end <= GAP_RUN_HOLE + 1 {
+            if gap[j] {
+                end = j;
+            }
+            j += 1;
+        }
+        let length: f64 = t.xyz[start..=end]
+            .windows(2)
+            .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+            .sum();
+        if length >= GAP_RUN_M {
+            runs[start..=end].iter_mut().for_each(|r| *r = true);
+        }
+        k = end + 1;
+    }
+    runs
 }
 
 /// Whether segments ab and cd cross (touching at an end point does not count).
@@ -784,7 +832,7 @@ mod tests {
     #[test]
     fn tracks_along_a_gap_in_the_returns_go_and_curb_toes_stay() {
         use crate::io::trajectory::Trajectory;
-        // A grid of returns 5 cm apart over 5 m along x. Across it (y): a curb top at
+        // A grid of returns 5 cm apart over 15 m along x. Across it (y): a curb top at
         // 0.12 m for y < -2, the road from -2 to 1, no returns from 1 to 4 (the vehicle's
         // body in the way), from 4 to 6 the top of a curb at 0.15 m whose toe at y = 4 the
         // curb's shadow hides the road before; then, past 4 m without returns, road from
@@ -796,7 +844,7 @@ mod tests {
             .chain(230..=240)
             .collect();
         for &iy in &rows {
-            for ix in 0..=100 {
+            for ix in 0..=300 {
                 x.push(ix as f64 * 0.05);
                 y.push(iy as f64 * 0.05);
                 z.push(if iy < -40 {
@@ -814,9 +862,13 @@ mod tests {
         let traj = Trajectory::default();
         let input = points.input(&traj);
         let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
+        let id = |row: i32, ix: u32| rows.iter().position(|&r| r == row).unwrap() as u32 * 301 + ix;
         let along = |row: i32| {
-            let k = rows.iter().position(|&r| r == row).unwrap() as u32 * 101;
-            Track::measured(&input, (k..k + 101).collect(), Side::Left)
+            Track::measured(
+                &input,
+                (0..=100).map(|ix| id(row, ix)).collect(),
+                Side::Left,
+            )
         };
         let (border, toe, shadowed, hidden) = (along(20), along(-40), along(80), along(210));
         let p = BendParams::default();
@@ -827,5 +879,20 @@ mod tests {
             &p,
         );
         assert_eq!(kept, vec![toe, shadowed, hidden]);
+        // A track along the gap's border for 3 m that comes off it onto the curb toe and
+        // follows that for 12 m: a fifth of its vertices at the gap, all in one run.
+        let joined = Track::measured(
+            &input,
+            (0..=60)
+                .map(|ix| id(20, ix))
+                .chain((60..=300).map(|ix| id(-40, ix)))
+                .collect(),
+            Side::Left,
+        );
+        let kept = remove_at_return_gaps(&input, &grid, vec![joined], &p);
+        assert_eq!(kept.len(), 1);
+        // The border goes but for the vertices whose direction spans the step onto the toe.
+        assert!(kept[0].xyz.iter().all(|q| q[1] == -2.0 || q[0] >= 2.7));
+        assert!(track_length_m(&input, &kept[0]) > 11.5);
     }
 }
