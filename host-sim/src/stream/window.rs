@@ -123,7 +123,9 @@ impl Keep {
     }
 
     fn has(&self, i: usize) -> bool {
-        self.bits.get(i / 64).is_some_and(|w| w >> (i % 64) & 1 == 1)
+        self.bits
+            .get(i / 64)
+            .is_some_and(|w| w >> (i % 64) & 1 == 1)
     }
 }
 
@@ -212,7 +214,10 @@ impl Columns {
         self.side_sp = sp;
         let new_front = self.gid(0);
         self.candidates.retain_mut(|(g, _)| {
-            let Some(i) = g.checked_sub(old_front).and_then(|i| usize::try_from(i).ok()) else {
+            let Some(i) = g
+                .checked_sub(old_front)
+                .and_then(|i| usize::try_from(i).ok())
+            else {
                 return false;
             };
             let at = if i >= n {
@@ -443,7 +448,12 @@ impl<'a> SectionWindow<'a> {
             }
         }
         // The side store is older than the rest; the cap counts the time the rest spans.
-        let t_first = self.cols.t.get(self.cols.side()).copied().unwrap_or(t_first);
+        let t_first = self
+            .cols
+            .t
+            .get(self.cols.side())
+            .copied()
+            .unwrap_or(t_first);
         if t_last - t_first > self.params.max_s.max(0.0) {
             out.extend(self.cap(t_last, s_last));
         }
@@ -669,7 +679,13 @@ fn extract_with_side(
     let side = c.side();
     let glo = c.base;
     let main_cands = candidates_in(c, side, hi);
-    bend::point_grid_slide(grid, &input_of(c, traj, side, hi, &main_cands), glo, cut, bend);
+    bend::point_grid_slide(
+        grid,
+        &input_of(c, traj, side, hi, &main_cands),
+        glo,
+        cut,
+        bend,
+    );
     let cands = candidates_in(c, 0, hi);
     let input = input_of(c, traj, 0, hi, &cands);
     bend::point_grid_slide(grid, &input, c.gid(0), None, bend);
@@ -820,5 +836,88 @@ mod tests {
         let open = drive(f64::INFINITY);
         assert!(open.peak_points >= 200 * 20_000, "{}", open.peak_points);
         assert_eq!(open.capped_points, 0);
+    }
+
+    /// A drive along x at 10 m/s for 20 s, the scanner 2 m up.
+    fn straight() -> Trajectory {
+        let mut csv = String::from("time,x,y,z,roll,pitch,heading\n");
+        for k in 0..=200 {
+            let t = k as f64 * 0.1;
+            csv.push_str(&format!("{t},{},0,2,0,0,90\n", 10.0 * t));
+        }
+        Trajectory::parse_csv(Path::new("straight.csv"), &csv).expect("trajectory parses")
+    }
+
+    /// A tenth of a second of `straight` from `t0`: per instant a ground point 25 m ahead
+    /// of the vehicle (8 m to its left), one 25 m behind (8 m to its right), one beside it
+    /// and one 10 m up beside it.
+    fn tenth(base: u64, t0: f64) -> CoreBatch {
+        let mut b = second(base, 0.0);
+        let n = 400;
+        let t: Vec<f64> = (0..n).map(|i| t0 + (i / 4) as f64 / 1000.0).collect();
+        let (ahead, aside, z) = (
+            [25.0, -25.0, 0.0, 0.0],
+            [8.0, -8.0, 3.0, 3.0],
+            [0.0, 0.0, 0.0, 12.0],
+        );
+        b.x = t
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| 10.0 * t + ahead[i % 4])
+            .collect();
+        b.y = (0..n).map(|i| aside[i % 4]).collect();
+        b.z = (0..n).map(|i| z[i % 4]).collect();
+        b.rho_deg.truncate(n);
+        b.status.truncate(n);
+        b.scanline.truncate(n);
+        b.t = t;
+        b
+    }
+
+    /// The points of `w` measured in `[t0, t1)` that lie (by x) in `[x0, x1)` at height `z`.
+    fn held(w: &SectionWindow, t: (f64, f64), x: (f64, f64), z: f64) -> usize {
+        let c = &w.cols;
+        (0..c.len())
+            .filter(|&i| (t.0..t.1).contains(&c.t[i]) && (x.0..x.1).contains(&c.x[i]))
+            .filter(|&i| c.z[i] == z)
+            .count()
+    }
+
+    #[test]
+    fn a_section_gets_the_road_level_points_that_lie_in_it_whenever_they_were_measured() {
+        let traj = straight();
+        let mut w = SectionWindow::new(&traj, WindowParams::default(), BendParams::default());
+        let mut feed = |w: &mut SectionWindow, from: usize, to: usize| {
+            for k in from..to {
+                w.push(tenth(k as u64 * 400, k as f64 / 10.0));
+            }
+        };
+        // The vehicle at 75 m: past section 0's end and margin (70 m), not past the wait
+        // for points lying behind it (80 m), so section 0 has not run. Its own points
+        // measured before the next window (50 m) are thinned to the road's level.
+        feed(&mut w, 0, 76);
+        assert_eq!(w.start, 0.0);
+        assert_eq!(held(&w, (0.0, 4.0), (0.0, 40.0), 12.0), 0);
+        assert!(held(&w, (0.0, 4.0), (0.0, 40.0), 0.0) >= 300);
+        // Points lying at 45-55 m, measured behind the vehicle at 70-75 m, are in the
+        // window when section 0 runs.
+        assert!(held(&w, (7.0, 7.6), (45.0, 55.0), 0.0) >= 100);
+        feed(&mut w, 76, 81);
+        assert_eq!(w.start, 60.0);
+        // After section 0: the ground points lying in section 1's window (from 50 m) that
+        // the vehicle measured 25 m behind them, before that window, are held for it...
+        assert!(held(&w, (2.5, 5.0), (50.0, 75.0), 0.0) >= 900);
+        // ...and the points that lie only in section 0 are released.
+        assert_eq!(held(&w, (0.0, 5.0), (0.0, 49.0), 0.0), 0);
+        assert_eq!(held(&w, (0.0, 5.0), (0.0, 200.0), 12.0), 0);
+        // Without the side store and the wait, the window is cut by the vehicle's station.
+        let params = WindowParams {
+            lead_max_m: 0.0,
+            lag_m: 0.0,
+            ..WindowParams::default()
+        };
+        let mut v = SectionWindow::new(&traj, params, BendParams::default());
+        feed(&mut v, 0, 81);
+        assert_eq!(held(&v, (2.5, 5.0), (50.0, 75.0), 0.0), 0);
     }
 }
