@@ -383,7 +383,7 @@ impl<'a> SectionWindow<'a> {
                 keep.push(i, f64::from(sp));
             }
         }
-        if !(lead_max > 0.0) {
+        if lead_max.is_nan() || lead_max <= 0.0 {
             return keep;
         }
         let samples = &self.traj.samples;
@@ -396,7 +396,8 @@ impl<'a> SectionWindow<'a> {
                 k += 1;
             }
             let Some(p) = samples.get(k) else { break };
-            if !(c.z[i] - p.z <= LOW_ABOVE_M) {
+            let above = c.z[i] - p.z;
+            if above.is_nan() || above > LOW_ABOVE_M {
                 continue;
             }
             let [fx, fy] = p.forward();
@@ -887,7 +888,7 @@ mod tests {
     fn a_section_gets_the_road_level_points_that_lie_in_it_whenever_they_were_measured() {
         let traj = straight();
         let mut w = SectionWindow::new(&traj, WindowParams::default(), BendParams::default());
-        let mut feed = |w: &mut SectionWindow, from: usize, to: usize| {
+        let feed = |w: &mut SectionWindow, from: usize, to: usize| {
             for k in from..to {
                 w.push(tenth(k as u64 * 400, k as f64 / 10.0));
             }
