@@ -98,6 +98,14 @@ pub struct Args {
     /// span times the point rate.
     #[arg(long, default_value_t = WindowParams::default().max_s)]
     pub window_max_s: f64,
+    /// Farthest ahead of the vehicle a point near the road's level may lie and still be
+    /// held for the section it lies in, metres (0: none).
+    #[arg(long, default_value_t = WindowParams::default().lead_max_m)]
+    pub lead_max_m: f64,
+    /// Road the window waits for past a section's margin, for points lying in it that the
+    /// vehicle measures later, metres (0: none).
+    #[arg(long, default_value_t = WindowParams::default().lag_m)]
+    pub lag_m: f64,
     /// No summary on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -145,6 +153,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 section_m: args.section_m,
                 margin_m: args.margin_m,
                 max_s: args.window_max_s,
+                lead_max_m: args.lead_max_m,
+                lag_m: args.lag_m,
             };
             stream::extract(&args.points, trajectory, &cfg, &opts, &window, &progress)?
         }

@@ -425,6 +425,8 @@ pub(super) fn stage_window(window: &WindowParams, cfg: &Config, rings: bool) -> 
             } else {
                 0.0
             },
+        // The arcs' reach covers what the rings see ahead: no side store.
+        lead_max_m: if rings { 0.0 } else { window.lead_max_m },
         ..*window
     }
 }

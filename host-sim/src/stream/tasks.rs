@@ -60,6 +60,8 @@ pub fn plan(traj: &Trajectory, window: &WindowParams, tasks: usize) -> Vec<TaskS
     let route = Route::new(traj);
     let l = window.section_m.max(1.0);
     let m = window.margin_m.max(0.0);
+    // A task reads from as far before its first section as the side store reaches back.
+    let lead = window.lead_max_m.max(0.0);
     let length = route.length_m();
     // `SectionWindow` runs sections 0, 1, … while k·l ≤ the route's length.
     let sections = if l > length {
@@ -92,7 +94,7 @@ pub fn plan(traj: &Trajectory, window: &WindowParams, tasks: usize) -> Vec<TaskS
             let t0 = if i == 0 {
                 f64::NEG_INFINITY
             } else {
-                before(k0 as f64 * l - m - PAD_M)
+                before(k0 as f64 * l - m - lead - PAD_M)
             };
             let t1 = if i == n - 1 {
                 f64::INFINITY

@@ -11,6 +11,14 @@
 //! point passes `s_k+1 + margin_m`, and afterwards the points before `s_k+1 − margin_m` are
 //! evicted. Memory is the window: `section_m + 2 margin_m` metres of road.
 //!
+//! A scanner yawed from across the road measures a curb `l` metres aside about `l ·
+//! tan(yaw)` ahead of the vehicle, farther than the margin on a side street's leg. The
+//! window therefore also holds, in a *side store* at the front of its columns, the evicted
+//! points near the road's level (at most [`LOW_ABOVE_M`] above the trajectory) that lie,
+//! by their own station, in a section still to run; each is released when the sections it
+//! lies in have run. Only points up to `lead_max_m` ahead of the vehicle are stored, so the
+//! store holds at most that much road's low points.
+//!
 //! Pieces cut at a section boundary are joined by the [`Merge`](super::merge::Merge).
 //! A section as long as the route gives one window holding every point, and the edges of
 //! the whole-file run unchanged.
@@ -47,6 +55,17 @@ pub struct WindowParams {
     /// window closes the section at the vehicle's station and drops the oldest points it
     /// still holds (counted), so memory is bounded by this span times the point rate.
     pub max_s: f64,
+    /// Farthest ahead of the vehicle, metres, that an evicted point near the road's level
+    /// may lie and still be held for the section it lies in (0: no side store). A mount
+    /// yawed from across the road measures a side street's leg `l` metres aside about `l ·
+    /// tan(yaw)` ahead of the vehicle (docs/results.md).
+    pub lead_max_m: f64,
+    /// Road the window waits for past a section's margin before it runs the section,
+    /// metres (0: none): a mount yawed the other way measures a side street's leg that far
+    /// behind the vehicle, after the vehicle has passed the section. While it waits, the
+    /// points only this section needs are thinned to those near the road's level, so the
+    /// wait costs little memory.
+    pub lag_m: f64,
 }
 
 impl Default for WindowParams {
@@ -55,14 +74,20 @@ impl Default for WindowParams {
             section_m: 60.0,
             margin_m: 10.0,
             max_s: 20.0,
+            lead_max_m: 40.0,
+            lag_m: 10.0,
         }
     }
 }
 
-/// The points of the window and their core output, indexed from `base` in the stream.
+/// The points of the window and their core output: first the side store (points kept past
+/// their eviction, with their own stations `side_sp`), then the points from stream index
+/// `base` on. The store's points are numbered just before `base`, so the window's points
+/// have consecutive indices (the store's are renumbered as it changes).
 #[derive(Default)]
 struct Columns {
     base: u64,
+    side_sp: Vec<f32>,
     x: Vec<f64>,
     y: Vec<f64>,
     z: Vec<f64>,
@@ -70,8 +95,38 @@ struct Columns {
     rho: Vec<f32>,
     status: Vec<Option<PointStatus>>,
     scanline: Vec<u32>,
-    /// Candidates with stream indices.
+    /// Candidates with the indices above.
     candidates: Vec<(u64, Candidate)>,
+}
+
+/// The points of a window's front to keep in its side store: a bit per point and the own
+/// station of each kept point, in order.
+struct Keep {
+    bits: Vec<u64>,
+    sp: Vec<f32>,
+}
+
+impl Keep {
+    fn new(n: usize) -> Self {
+        Self {
+            bits: vec![0; n.div_ceil(64)],
+            sp: Vec::new(),
+        }
+    }
+
+    /// Keeps point `i` (above every point kept so far), lying at station `sp`.
+    fn push(&mut self, i: usize, sp: f64) {
+        if let Some(w) = self.bits.get_mut(i / 64) {
+            *w |= 1 << (i % 64);
+            self.sp.push(sp as f32);
+        }
+    }
+
+    fn has(&self, i: usize) -> bool {
+        self.bits
+            .get(i / 64)
+            .is_some_and(|w| w >> (i % 64) & 1 == 1)
+    }
 }
 
 impl Columns {
@@ -79,9 +134,24 @@ impl Columns {
         self.t.len()
     }
 
+    /// Points in the side store, at the front of the columns.
+    fn side(&self) -> usize {
+        self.side_sp.len()
+    }
+
+    /// Index of the point at `i`.
+    fn gid(&self, i: usize) -> u64 {
+        (self.base + i as u64).saturating_sub(self.side() as u64)
+    }
+
     fn append(&mut self, b: CoreBatch) {
-        if self.t.is_empty() {
+        if self.t.len() == self.side() {
+            // The store's points are numbered just before the first of the rest.
+            let old = self.base;
             self.base = b.base;
+            for (g, _) in &mut self.candidates {
+                *g = (*g + b.base).saturating_sub(old);
+            }
         }
         let s = b.skip.min(b.t.len());
         // Grow by a 32nd at a time, not by doubling: the window's columns are most of the
@@ -114,17 +184,67 @@ impl Columns {
     }
 
     fn evict(&mut self, n: usize) {
-        self.x.drain(..n);
-        self.y.drain(..n);
-        self.z.drain(..n);
-        self.t.drain(..n);
-        self.rho.drain(..n);
-        self.status.drain(..n);
-        self.scanline.drain(..n);
-        self.base += n as u64;
-        let base = self.base;
-        self.candidates.retain(|c| c.0 >= base);
+        self.evict_keeping(n, Keep::new(0));
     }
+
+    /// Evicts the first `n` points but those `keep` holds, which join the side store
+    /// before the store's points at or after `n`.
+    fn evict_keeping(&mut self, n: usize, mut keep: Keep) {
+        let n = n.min(self.len());
+        let side = self.side();
+        let old_front = self.gid(0);
+        // Rank of each kept point: the kept points before each word of the bitmap.
+        let mut before = Vec::with_capacity(keep.bits.len());
+        let mut c = 0u32;
+        for w in &keep.bits {
+            before.push(c);
+            c += w.count_ones();
+        }
+        let kept = keep.sp.len();
+        let mut sp = std::mem::take(&mut keep.sp);
+        sp.extend_from_slice(&self.side_sp[n.min(side)..]);
+        compact(&mut self.x, &keep, n);
+        compact(&mut self.y, &keep, n);
+        compact(&mut self.z, &keep, n);
+        compact(&mut self.t, &keep, n);
+        compact(&mut self.rho, &keep, n);
+        compact(&mut self.status, &keep, n);
+        compact(&mut self.scanline, &keep, n);
+        self.base += n.saturating_sub(side) as u64;
+        self.side_sp = sp;
+        let new_front = self.gid(0);
+        self.candidates.retain_mut(|(g, _)| {
+            let Some(i) = g
+                .checked_sub(old_front)
+                .and_then(|i| usize::try_from(i).ok())
+            else {
+                return false;
+            };
+            let at = if i >= n {
+                kept + (i - n)
+            } else if keep.has(i) {
+                let w = keep.bits[i / 64] & ((1u64 << (i % 64)) - 1);
+                before[i / 64] as usize + w.count_ones() as usize
+            } else {
+                return false;
+            };
+            *g = new_front + at as u64;
+            true
+        });
+    }
+}
+
+/// Moves the points `keep` holds among the first `n` of `v` to the front, in order, and
+/// drops the rest of those `n`.
+fn compact<T: Copy>(v: &mut Vec<T>, keep: &Keep, n: usize) {
+    let mut w = 0;
+    for i in 0..n {
+        if keep.has(i) {
+            v[w] = v[i];
+            w += 1;
+        }
+    }
+    v.drain(w..n);
 }
 
 fn grow<T>(v: &mut Vec<T>, cap: usize) {
@@ -140,6 +260,8 @@ pub struct SectionWindow<'a> {
     cols: Columns,
     /// Station where the next section starts.
     start: f64,
+    /// Station up to which the points only the next section needs are thinned.
+    thinned: f64,
     merge: Merge,
     /// Sections whose pieces are kept for a merge elsewhere instead of merged here.
     keep: Option<std::ops::Range<i64>>,
@@ -160,6 +282,15 @@ pub struct SectionWindow<'a> {
 /// below it (a standing vehicle) the cap only drops the oldest points.
 const CAP_MIN_SECTION_M: f64 = 1.0;
 
+/// Highest above the trajectory (the scanner) a point is still near the road's level for
+/// the side store, metres: curbs lie a metre or more below a scanner on a vehicle's roof,
+/// building fronts and tops reach far above it.
+pub(super) const LOW_ABOVE_M: f64 = 0.5;
+
+/// Farthest aside of the route a point is held in the side store, metres: the side
+/// streets' legs a track follows lie within it.
+const SIDE_ASIDE_M: f64 = 30.0;
+
 impl<'a> SectionWindow<'a> {
     /// A window over `traj`'s route.
     pub fn new(traj: &'a Trajectory, params: WindowParams, bend: BendParams) -> Self {
@@ -171,6 +302,7 @@ impl<'a> SectionWindow<'a> {
             params,
             cols: Columns::default(),
             start: 0.0,
+            thinned: f64::NEG_INFINITY,
             keep: None,
             kept: Vec::new(),
             peak_points: 0,
@@ -221,6 +353,67 @@ impl<'a> SectionWindow<'a> {
         self.params.margin_m.max(0.0)
     }
 
+    fn lag_m(&self) -> f64 {
+        self.params.lag_m.max(0.0)
+    }
+
+    /// Moves the points only the section ending at `s1` needs (measured before its end
+    /// less the margin) near the road's level into the side store and drops the others.
+    fn thin(&mut self, s1: f64) {
+        let upto = self
+            .cols
+            .t
+            .partition_point(|&t| self.station(t) < s1 - self.margin_m());
+        let keep = self.keep_low(upto, f64::NEG_INFINITY, f64::INFINITY);
+        self.cols.evict_keeping(upto, keep);
+        self.thinned = s1;
+    }
+
+    /// The first `n` points to keep in the side store: those of the store that lie at or
+    /// after station `from`, and the others near the road's level (at most
+    /// [`LOW_ABOVE_M`] above the trajectory) within [`SIDE_ASIDE_M`] aside of the vehicle,
+    /// at most `lead_max` ahead of it, that lie at or after `from` (the vehicle's station
+    /// and how far ahead of it the point lies).
+    fn keep_low(&self, n: usize, from: f64, lead_max: f64) -> Keep {
+        let c = &self.cols;
+        let n = n.min(c.len());
+        let mut keep = Keep::new(n);
+        for (i, &sp) in c.side_sp.iter().enumerate().take(n) {
+            if f64::from(sp) >= from {
+                keep.push(i, f64::from(sp));
+            }
+        }
+        if lead_max.is_nan() || lead_max <= 0.0 {
+            return keep;
+        }
+        let samples = &self.traj.samples;
+        let mut k = 0;
+        for i in c.side()..n {
+            // The trajectory's sample at or before the point's time (points come in time
+            // order, so the cursor only moves on).
+            let t = c.t[i];
+            while k + 1 < samples.len() && samples[k + 1].t <= t {
+                k += 1;
+            }
+            let Some(p) = samples.get(k) else { break };
+            let above = c.z[i] - p.z;
+            if above.is_nan() || above > LOW_ABOVE_M {
+                continue;
+            }
+            let [fx, fy] = p.forward();
+            let (dx, dy) = (c.x[i] - p.x, c.y[i] - p.y);
+            let ahead = dx * fx + dy * fy;
+            let aside = dx * fy - dy * fx;
+            if ahead <= lead_max && aside.abs() <= SIDE_ASIDE_M {
+                let sp = self.station(t) + ahead;
+                if sp >= from {
+                    keep.push(i, sp);
+                }
+            }
+        }
+        keep
+    }
+
     fn station(&self, t: f64) -> f64 {
         self.route.arc_at(t).unwrap_or(0.0)
     }
@@ -243,10 +436,25 @@ impl<'a> SectionWindow<'a> {
             // A section longer than the route asks for the whole input in one window.
             return out;
         }
-        let (l, m) = (self.section_m(), self.margin_m());
-        while self.start + l + m <= s_last {
-            out.extend(self.run_section(self.start + l));
+        let (l, m, lag) = (self.section_m(), self.margin_m(), self.lag_m());
+        loop {
+            let s1 = self.start + l;
+            if s1 + m + lag <= s_last {
+                out.extend(self.run_section(s1));
+            } else {
+                if lag > 0.0 && s1 + m <= s_last && self.thinned < s1 {
+                    self.thin(s1);
+                }
+                break;
+            }
         }
+        // The side store is older than the rest; the cap counts the time the rest spans.
+        let t_first = self
+            .cols
+            .t
+            .get(self.cols.side())
+            .copied()
+            .unwrap_or(t_first);
         if t_last - t_first > self.params.max_s.max(0.0) {
             out.extend(self.cap(t_last, s_last));
         }
@@ -310,7 +518,10 @@ impl<'a> SectionWindow<'a> {
         while s0 <= end && from < n {
             let s1 = s0 + l;
             let lo = self.cols.t.partition_point(|&t| self.station(t) < s0 - m);
-            let hi = self.cols.t.partition_point(|&t| self.station(t) < s1 + m);
+            let hi = self
+                .cols
+                .t
+                .partition_point(|&t| self.station(t) < s1 + m + self.lag_m());
             from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
             sections.push((s0, s1, lo, hi, from));
             s0 = s1;
@@ -361,7 +572,10 @@ impl<'a> SectionWindow<'a> {
         let m = self.margin_m();
         let s0 = self.start;
         let lo = self.cols.t.partition_point(|&t| self.station(t) < s0 - m);
-        let hi = self.cols.t.partition_point(|&t| self.station(t) < s1 + m);
+        let hi = self
+            .cols
+            .t
+            .partition_point(|&t| self.station(t) < s1 + m + self.lag_m());
         // Where the next section's points begin: the grid's new slabs are cut there.
         let keep_from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
         let edges = if hi > lo {
@@ -371,7 +585,8 @@ impl<'a> SectionWindow<'a> {
         };
         let closed = self.close_section(edges, s0, s1);
         self.start = s1;
-        self.cols.evict(keep_from);
+        let keep = self.keep_low(keep_from, s1 - m, self.params.lead_max_m);
+        self.cols.evict_keeping(keep_from, keep);
         closed
     }
 
@@ -436,17 +651,72 @@ fn extract_on(
     hi: usize,
     cut: Option<usize>,
 ) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
-    let (glo, ghi) = (c.base + lo as u64, c.base + hi as u64);
-    let cands: Vec<Candidate> = c
-        .candidates
+    if c.side() > 0 && lo == c.side() {
+        // The section begins where the side store ends: the store's points come first.
+        return extract_with_side(c, traj, route, bend, grid, hi, cut);
+    }
+    let cands = candidates_in(c, lo, hi);
+    let input = input_of(c, traj, lo, hi, &cands);
+    // One index for the tracker and the curb annotation.
+    bend::point_grid_slide(grid, &input, c.gid(lo), cut, bend);
+    let mut edges = bend::extract_edges_on_grid(&input, grid, route, bend);
+    curb::annotate(&input, grid, route, edges.iter_mut().map(|(e, _)| e));
+    edges
+}
+
+/// The bend method on the side store and the points after it up to `hi`: the grid slides
+/// on over the points after the store as in [`extract_on`] (so its slabs below them are
+/// dropped), then indexes the store in a slab of its own just before them.
+#[allow(clippy::too_many_arguments)]
+fn extract_with_side(
+    c: &Columns,
+    traj: &Trajectory,
+    route: &Route,
+    bend: &BendParams,
+    grid: &mut PointGrid,
+    hi: usize,
+    cut: Option<usize>,
+) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
+    let side = c.side();
+    let glo = c.base;
+    let main_cands = candidates_in(c, side, hi);
+    bend::point_grid_slide(
+        grid,
+        &input_of(c, traj, side, hi, &main_cands),
+        glo,
+        cut,
+        bend,
+    );
+    let cands = candidates_in(c, 0, hi);
+    let input = input_of(c, traj, 0, hi, &cands);
+    bend::point_grid_slide(grid, &input, c.gid(0), None, bend);
+    let mut edges = bend::extract_edges_on_grid(&input, grid, route, bend);
+    curb::annotate(&input, grid, route, edges.iter_mut().map(|(e, _)| e));
+    edges
+}
+
+/// The candidates among the points `lo..hi` of `c`, indexed from `lo`.
+fn candidates_in(c: &Columns, lo: usize, hi: usize) -> Vec<Candidate> {
+    let (glo, ghi) = (c.gid(lo), c.gid(hi));
+    c.candidates
         .iter()
         .filter(|(g, _)| (glo..ghi).contains(g))
         .map(|(g, cand)| Candidate {
             point: (g - glo) as u32,
             ..*cand
         })
-        .collect();
-    let input = BendInput {
+        .collect()
+}
+
+/// The bend method's input over the points `lo..hi` of `c`.
+fn input_of<'c>(
+    c: &'c Columns,
+    traj: &'c Trajectory,
+    lo: usize,
+    hi: usize,
+    cands: &'c [Candidate],
+) -> BendInput<'c> {
+    BendInput {
         x: &c.x[lo..hi],
         y: &c.y[lo..hi],
         z: &c.z[lo..hi],
@@ -454,14 +724,9 @@ fn extract_on(
         rho_deg: &c.rho[lo..hi],
         status: &c.status[lo..hi],
         scanline: &c.scanline[lo..hi],
-        candidates: &cands,
+        candidates: cands,
         trajectory: traj,
-    };
-    // One index for the tracker and the curb annotation.
-    bend::point_grid_slide(grid, &input, glo, cut, bend);
-    let mut edges = bend::extract_edges_on_grid(&input, grid, route, bend);
-    curb::annotate(&input, grid, route, edges.iter_mut().map(|(e, _)| e));
-    edges
+    }
 }
 
 /// The runs of an edge's vertices whose station lies in `[s0, s1)`, each as a piece.
@@ -572,5 +837,88 @@ mod tests {
         let open = drive(f64::INFINITY);
         assert!(open.peak_points >= 200 * 20_000, "{}", open.peak_points);
         assert_eq!(open.capped_points, 0);
+    }
+
+    /// A drive along x at 10 m/s for 20 s, the scanner 2 m up.
+    fn straight() -> Trajectory {
+        let mut csv = String::from("time,x,y,z,roll,pitch,heading\n");
+        for k in 0..=200 {
+            let t = k as f64 * 0.1;
+            csv.push_str(&format!("{t},{},0,2,0,0,90\n", 10.0 * t));
+        }
+        Trajectory::parse_csv(Path::new("straight.csv"), &csv).expect("trajectory parses")
+    }
+
+    /// A tenth of a second of `straight` from `t0`: per instant a ground point 25 m ahead
+    /// of the vehicle (8 m to its left), one 25 m behind (8 m to its right), one beside it
+    /// and one 10 m up beside it.
+    fn tenth(base: u64, t0: f64) -> CoreBatch {
+        let mut b = second(base, 0.0);
+        let n = 400;
+        let t: Vec<f64> = (0..n).map(|i| t0 + (i / 4) as f64 / 1000.0).collect();
+        let (ahead, aside, z) = (
+            [25.0, -25.0, 0.0, 0.0],
+            [8.0, -8.0, 3.0, 3.0],
+            [0.0, 0.0, 0.0, 12.0],
+        );
+        b.x = t
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| 10.0 * t + ahead[i % 4])
+            .collect();
+        b.y = (0..n).map(|i| aside[i % 4]).collect();
+        b.z = (0..n).map(|i| z[i % 4]).collect();
+        b.rho_deg.truncate(n);
+        b.status.truncate(n);
+        b.scanline.truncate(n);
+        b.t = t;
+        b
+    }
+
+    /// The points of `w` measured in `[t0, t1)` that lie (by x) in `[x0, x1)` at height `z`.
+    fn held(w: &SectionWindow, t: (f64, f64), x: (f64, f64), z: f64) -> usize {
+        let c = &w.cols;
+        (0..c.len())
+            .filter(|&i| (t.0..t.1).contains(&c.t[i]) && (x.0..x.1).contains(&c.x[i]))
+            .filter(|&i| c.z[i] == z)
+            .count()
+    }
+
+    #[test]
+    fn a_section_gets_the_road_level_points_that_lie_in_it_whenever_they_were_measured() {
+        let traj = straight();
+        let mut w = SectionWindow::new(&traj, WindowParams::default(), BendParams::default());
+        let feed = |w: &mut SectionWindow, from: usize, to: usize| {
+            for k in from..to {
+                w.push(tenth(k as u64 * 400, k as f64 / 10.0));
+            }
+        };
+        // The vehicle at 75 m: past section 0's end and margin (70 m), not past the wait
+        // for points lying behind it (80 m), so section 0 has not run. Its own points
+        // measured before the next window (50 m) are thinned to the road's level.
+        feed(&mut w, 0, 76);
+        assert_eq!(w.start, 0.0);
+        assert_eq!(held(&w, (0.0, 4.0), (0.0, 40.0), 12.0), 0);
+        assert!(held(&w, (0.0, 4.0), (0.0, 40.0), 0.0) >= 300);
+        // Points lying at 45-55 m, measured behind the vehicle at 70-75 m, are in the
+        // window when section 0 runs.
+        assert!(held(&w, (7.0, 7.6), (45.0, 55.0), 0.0) >= 100);
+        feed(&mut w, 76, 81);
+        assert_eq!(w.start, 60.0);
+        // After section 0: the ground points lying in section 1's window (from 50 m) that
+        // the vehicle measured 25 m behind them, before that window, are held for it...
+        assert!(held(&w, (2.5, 5.0), (50.0, 75.0), 0.0) >= 900);
+        // ...and the points that lie only in section 0 are released.
+        assert_eq!(held(&w, (0.0, 5.0), (0.0, 49.0), 0.0), 0);
+        assert_eq!(held(&w, (0.0, 5.0), (0.0, 200.0), 12.0), 0);
+        // Without the side store and the wait, the window is cut by the vehicle's station.
+        let params = WindowParams {
+            lead_max_m: 0.0,
+            lag_m: 0.0,
+            ..WindowParams::default()
+        };
+        let mut v = SectionWindow::new(&traj, params, BendParams::default());
+        feed(&mut v, 0, 81);
+        assert_eq!(held(&v, (2.5, 5.0), (50.0, 75.0), 0.0), 0);
     }
 }
