@@ -388,6 +388,8 @@ impl<'a> SectionWindow<'a> {
         }
         let samples = &self.traj.samples;
         let mut k = 0;
+        // The forward vector of sample `k`, computed once per sample (a sine and a cosine).
+        let mut forward: Option<(usize, [f64; 2])> = None;
         for i in c.side()..n {
             // The trajectory's sample at or before the point's time (points come in time
             // order, so the cursor only moves on).
@@ -400,7 +402,14 @@ impl<'a> SectionWindow<'a> {
             if above.is_nan() || above > LOW_ABOVE_M {
                 continue;
             }
-            let [fx, fy] = p.forward();
+            let [fx, fy] = match forward {
+                Some((j, f)) if j == k => f,
+                _ => {
+                    let f = p.forward();
+                    forward = Some((k, f));
+                    f
+                }
+            };
             let (dx, dy) = (c.x[i] - p.x, c.y[i] - p.y);
             let ahead = dx * fx + dy * fy;
             let aside = dx * fy - dy * fx;
