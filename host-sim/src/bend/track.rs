@@ -387,15 +387,6 @@ const CLIMB_DROP_M: f64 = 1.0;
 /// 25° at a 30 m radius), a corner's and a side street's curb by up to 60–120°.
 const ALONG_ROAD_MAX_DEG: f64 = 40.0;
 
-/// Longest gap, metres, a track that has followed a curb for at least
-/// [`CUT_MIN_TRACK_STEPS`] steps crosses where its search finds no return at all (a hole in
-/// the returns, not flat road: on flat road the search set holds returns with a low bend
-/// angle, and those gap steps stay bounded by `max_gap_steps`). A side street's leg seen
-/// from the main road lies 10–30 m aside, where the corner's or a parked car's shadow leaves
-/// no return on the toe for 1–2 m; nothing seeds a track on the leg beyond the hole, so the
-/// track that reached it is the only one that can follow the leg.
-const HOLE_GAP_M: f64 = 2.5;
-
 /// Whether the horizontal unit direction `a` runs along the road, either way: within
 /// [`ALONG_ROAD_MAX_DEG`] of the driving direction when the track's newest measured vertex
 /// (or `start`) was scanned. True where the trajectory does not say.
@@ -494,8 +485,6 @@ fn track_one_way(
     let mut own_pts: std::collections::HashSet<u32> = std::collections::HashSet::new();
     own_pts.insert(start);
     let mut gap = 0u32;
-    // Steps of the current gap that found no return at all.
-    let mut holes = 0u32;
     // Turn of the search direction per step (radians, left positive), averaged: carries
     // the track round a corner across a gap.
     let mut turn = 0.0f64;
@@ -651,17 +640,6 @@ fn track_one_way(
                 }
                 None => None,
             };
-            // A step whose search finds no return at all lies in a hole in the returns (a
-            // shadow); a track that has followed a curb crosses up to [`HOLE_GAP_M`] of
-            // such steps on its line, past the steps `max_gap_steps` allows.
-            let hole = set.is_empty() && picked.len() + prior_steps >= CUT_MIN_TRACK_STEPS;
-            let (max_gap, weak_max) = if hole || holes > 0 {
-                let cap = ((HOLE_GAP_M / d_s).ceil() as u32).max(params.max_gap_steps);
-                let steps = params.max_gap_steps + holes + u32::from(hole);
-                (steps.min(cap), params.weak_run_max_m.max(HOLE_GAP_M + d_s))
-            } else {
-                (params.max_gap_steps, params.weak_run_max_m)
-            };
             match found {
                 Some(toe) => {
                     weak_run_m = 0.0;
@@ -670,12 +648,11 @@ fn track_one_way(
                     *next_virtual += 1;
                     (id, toe.xyz)
                 }
-                None if gap < max_gap => {
+                None if gap < params.max_gap_steps => {
                     gap += 1;
-                    holes += u32::from(hole);
                     weak_run_m += d_s;
                     weak_from.get_or_insert(picked.len());
-                    if params.weak_run_max_m > 0.0 && weak_run_m > weak_max {
+                    if params.weak_run_max_m > 0.0 && weak_run_m > params.weak_run_max_m {
                         break;
                     }
                     cur = pred;
@@ -853,7 +830,6 @@ fn track_one_way(
         own_pts.insert(n);
         cur = p;
         gap = 0;
-        holes = 0;
     }
     // A short run on curb-cut toes that the track ends in is a few breaks of slope the
     // prediction happened to meet, not a cut followed: it is dropped, so that the track
