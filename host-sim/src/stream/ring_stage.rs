@@ -55,7 +55,7 @@ fn body_of(cur: &mut PoseCursor<'_>, x: f64, y: f64, z: f64, t: f64) -> Option<B
 
 /// A point in the vehicle frame `(q, l)` (origin, left vector).
 #[inline]
-fn body_in((q, l): ([f64; 3], [f64; 2]), x: f64, y: f64, z: f64) -> Body {
+fn body_in((q, l): Frame, x: f64, y: f64, z: f64) -> Body {
     let (dx, dy) = (x - q[0], y - q[1]);
     Body {
         x: (dx * l[1] - dy * l[0]) as f32,
@@ -64,6 +64,9 @@ fn body_in((q, l): ([f64; 3], [f64; 2]), x: f64, y: f64, z: f64) -> Body {
     }
 }
 
+/// A vehicle frame: the scanner origin and the left vector ([`PoseCursor::frame_at`]).
+type Frame = ([f64; 3], [f64; 2]);
+
 /// The vehicle frames of points taken in time order: the trajectory's cursor, and the
 /// frame of the last time asked for, which the next point often shares (a spinning head
 /// fires its lasers in blocks at one instant). A frame depends on its time alone, so the
@@ -71,7 +74,7 @@ fn body_in((q, l): ([f64; 3], [f64; 2]), x: f64, y: f64, z: f64) -> Body {
 struct Frames<'a> {
     cur: PoseCursor<'a>,
     /// The bits of the last time and its frame (`None` outside the trajectory).
-    last: (u64, Option<([f64; 3], [f64; 2])>),
+    last: (u64, Option<Frame>),
 }
 
 impl<'a> Frames<'a> {
