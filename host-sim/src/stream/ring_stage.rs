@@ -50,13 +50,51 @@ struct Body {
 }
 
 fn body_of(cur: &mut PoseCursor<'_>, x: f64, y: f64, z: f64, t: f64) -> Option<Body> {
-    let (q, l) = cur.frame_at(t)?;
+    cur.frame_at(t).map(|f| body_in(f, x, y, z))
+}
+
+/// A point in the vehicle frame `(q, l)` (origin, left vector).
+#[inline]
+fn body_in((q, l): Frame, x: f64, y: f64, z: f64) -> Body {
     let (dx, dy) = (x - q[0], y - q[1]);
-    Some(Body {
+    Body {
         x: (dx * l[1] - dy * l[0]) as f32,
         y: (dx * l[0] + dy * l[1]) as f32,
         z: (z - q[2]) as f32,
-    })
+    }
+}
+
+/// A vehicle frame: the scanner origin and the left vector ([`PoseCursor::frame_at`]).
+type Frame = ([f64; 3], [f64; 2]);
+
+/// The vehicle frames of points taken in time order: the trajectory's cursor, and the
+/// frame of the last time asked for, which the next point often shares (a spinning head
+/// fires its lasers in blocks at one instant). A frame depends on its time alone, so the
+/// frame kept is the one the cursor would give again.
+struct Frames<'a> {
+    cur: PoseCursor<'a>,
+    /// The bits of the last time and its frame (`None` outside the trajectory).
+    last: (u64, Option<Frame>),
+}
+
+impl<'a> Frames<'a> {
+    fn new(traj: &'a Trajectory) -> Self {
+        let mut cur = PoseCursor::new(traj);
+        let nan = f64::NAN;
+        Self {
+            last: (nan.to_bits(), cur.frame_at(nan)),
+            cur,
+        }
+    }
+
+    /// The point (`x`, `y`, `z`) at time `t` in the vehicle frame of `t`.
+    #[inline]
+    fn body(&mut self, x: f64, y: f64, z: f64, t: f64) -> Option<Body> {
+        if t.to_bits() != self.last.0 {
+            self.last = (t.to_bits(), self.cur.frame_at(t));
+        }
+        self.last.1.map(|f| body_in(f, x, y, z))
+    }
 }
 
 /// Whether the points of `b` come from a spinning multi-beam sensor (module constant
@@ -214,10 +252,12 @@ pub struct RingStage<'a> {
     kernel: Option<KernelParams>,
     sensor: Option<SensorModel>,
     carry: PointBatch,
-    /// The vehicle-frame coordinates of the first carried points (computed once).
-    body: Vec<Body>,
+    /// The vehicle frames of the carried points, in time order.
+    frames: Frames<'a>,
     /// Carried points already sorted into runs (each point is looked at once).
     scanned: usize,
+    /// The points' buffers of runs already sent, kept for new runs.
+    spare: Vec<Vec<RunPoint>>,
     /// Each ring's open run, by ring number.
     open: Vec<Option<Run>>,
     /// Runs ended but not yet sent: they reach past the cut of an earlier batch.
@@ -251,8 +291,9 @@ impl<'a> RingStage<'a> {
             kernel,
             sensor: None,
             carry: PointBatch::default(),
-            body: Vec::new(),
+            frames: Frames::new(traj),
             scanned: 0,
+            spare: Vec::new(),
             open: (0..256).map(|_| None).collect(),
             ended: Vec::new(),
             left_out: Vec::new(),
@@ -328,22 +369,14 @@ impl<'a> RingStage<'a> {
         let gap = 0.25 * period;
         let c = &self.carry;
         let n = c.len();
-        let mut body = std::mem::take(&mut self.body);
-        if body.len() < n {
-            let mut cur = PoseCursor::new(self.traj);
-            body.extend((body.len()..n).map(|i| {
-                body_of(&mut cur, c.x[i], c.y[i], c.z[i], c.t[i]).unwrap_or(Body {
-                    x: f32::NAN,
-                    y: f32::NAN,
-                    z: f32::NAN,
-                })
-            }));
-        }
         // Runs carry over between batches: only the points new since the last batch are
-        // sorted into them.
+        // sorted into them, each brought into its vehicle frame as it is looked at.
         let (min2, tan_max) = (self.arc.min_range_m.powi(2), self.arc.max_azimuth_tan());
         self.left_out.resize(n, 0);
-        for (i, &p) in body.iter().enumerate().skip(self.scanned) {
+        for i in self.scanned..n {
+            let Some(p) = self.frames.body(c.x[i], c.y[i], c.z[i], c.t[i]) else {
+                continue;
+            };
             if p.x.is_nan() {
                 continue;
             }
@@ -358,27 +391,26 @@ impl<'a> RingStage<'a> {
             let ring = c.channel[i];
             self.rings_seen[usize::from(ring >> 6)] |= 1 << (ring & 63);
             let front = p.x >= 0.0;
+            let q = RunPoint {
+                i: i as u32,
+                b: p,
+                intensity: c.intensity[i],
+            };
             let slot = &mut self.open[usize::from(ring)];
             match slot {
                 Some(r) if r.front == front && c.t[i] - r.last_t <= gap => {
-                    r.points.push(RunPoint {
-                        i: i as u32,
-                        b: p,
-                        intensity: c.intensity[i],
-                    });
+                    r.points.push(q);
                     r.last_t = c.t[i];
                 }
                 _ => {
                     if let Some(r) = slot.take() {
                         self.ended.push(r);
                     }
+                    let mut points = self.spare.pop().unwrap_or_default();
+                    points.push(q);
                     *slot = Some(Run {
                         front,
-                        points: vec![RunPoint {
-                            i: i as u32,
-                            b: p,
-                            intensity: c.intensity[i],
-                        }],
+                        points,
                         last_t: c.t[i],
                     });
                 }
@@ -419,7 +451,6 @@ impl<'a> RingStage<'a> {
             cut = c2;
         }
         if cut == 0 {
-            self.body = body;
             return Ok(None);
         }
         // Ended runs before the cut go now; the rest wait, renumbered from the cut.
@@ -439,27 +470,34 @@ impl<'a> RingStage<'a> {
         self.arcs.points_lateral += left_out[..cut].iter().filter(|&&f| f == 2).count() as u64;
         let mut arcs: Vec<Vec<RunPoint>> = Vec::with_capacity(closed.len());
         for r in closed {
-            if let Some(a) = self.accept(r) {
-                arcs.push(a);
+            match self.accept(r) {
+                Ok(a) => arcs.push(a),
+                Err(mut spare) => {
+                    spare.clear();
+                    self.spare.push(spare);
+                }
             }
         }
         let kernel = self.kernel.unwrap_or_else(|| sensor.kernel_params());
         let out = self.run_core(&arcs, &sensor, &kernel, cut)?;
-        body.drain(..cut);
-        self.body = body;
+        self.spare.extend(arcs.into_iter().map(|mut a| {
+            a.clear();
+            a
+        }));
         self.left_out = left_out;
         self.left_out.drain(..cut);
         self.scanned -= cut;
         Ok(Some(out))
     }
 
-    /// Thinning and the road checks of one run (`rings::arc`'s rule): the arc's points.
-    fn accept(&mut self, r: Run) -> Option<Vec<RunPoint>> {
+    /// Thinning and the road checks of one run (`rings::arc`'s rule): the arc's points, or
+    /// the run's buffer back when the run is skipped.
+    fn accept(&mut self, r: Run) -> Result<Vec<RunPoint>, Vec<RunPoint>> {
         let p = &self.arc;
         let c = &mut self.arcs;
         if r.points.len() < p.min_points {
             c.skipped_short += 1;
-            return None;
+            return Err(r.points);
         }
         let sep2 = p.min_separation_m * p.min_separation_m;
         let mut pts = r.points;
@@ -474,10 +512,13 @@ impl<'a> RingStage<'a> {
             lastp = (xp, zp);
             true
         });
-        let nadir = pts
+        let Some(nadir) = pts
             .iter()
-            .min_by(|a, b| a.b.y.abs().total_cmp(&b.b.y.abs()))?
-            .b;
+            .min_by(|a, b| a.b.y.abs().total_cmp(&b.b.y.abs()))
+        else {
+            return Err(pts);
+        };
+        let nadir = nadir.b;
         let mut centre: Vec<f32> = pts
             .iter()
             .filter(|q| q.b.y.abs() <= 1.0)
@@ -485,21 +526,21 @@ impl<'a> RingStage<'a> {
             .collect();
         if centre.is_empty() {
             c.skipped_no_road += 1;
-            return None;
+            return Err(pts);
         }
         let mid = centre.len() / 2;
         let z_mid = *centre.select_nth_unstable_by(mid, f32::total_cmp).1;
         if z_mid > -p.min_depth_m {
             c.skipped_no_road += 1;
-            return None;
+            return Err(pts);
         }
         if nadir.x.abs() > p.max_reach_m {
             c.skipped_far += 1;
-            return None;
+            return Err(pts);
         }
         c.arcs += 1;
         c.points_in_arcs += pts.len() as u64;
-        Some(pts)
+        Ok(pts)
     }
 
     /// Runs `arcs` through a fresh pipeline (`rings::run`: config packet first, one line
@@ -735,6 +776,32 @@ mod tests {
             left >= 2 * RINGS && right == 0,
             "{left} left, {right} right"
         );
+    }
+
+    #[test]
+    fn frames_give_the_cursors_bits_for_repeated_and_earlier_times() {
+        let csv = "time,x,y,z,roll,pitch,heading\n100,0,0,1.8,0,0,0\n101,3,4,1.9,0,0,30\n102,5,9,2.0,0,0,75\n";
+        let tr = Trajectory::parse_csv(Path::new("t.csv"), csv).expect("trajectory parses");
+        let mut frames = Frames::new(&tr);
+        let bits = |b: Option<Body>| b.map(|b| [b.x.to_bits(), b.y.to_bits(), b.z.to_bits()]);
+        for &t in &[
+            100.25,
+            100.25,
+            100.25,
+            101.5,
+            100.75,
+            100.75,
+            99.0,
+            99.0,
+            101.5,
+            f64::NAN,
+        ] {
+            let (x, y, z) = (7.0 + t, -2.0, 0.5);
+            let mut cur = PoseCursor::new(&tr);
+            let fresh = body_of(&mut cur, x, y, z, t);
+            assert_eq!(bits(frames.body(x, y, z, t)), bits(fresh), "t = {t}");
+        }
+        assert!(frames.body(1.0, 1.0, 1.0, 99.0).is_none());
     }
 
     #[test]
