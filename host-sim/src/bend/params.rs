@@ -109,6 +109,11 @@ pub struct BendParams {
     /// is there between the scanlines. 15 m reaches the far curb of a 14 m road from the
     /// near lane.
     pub profile_seed_reach_m: f64,
+    /// Whether a track whose ordinary profiles see no toe tries the far leg's longer
+    /// profile (`leg::leg_toe`). Not a `[bend]` setting: on profilers it is on; on a ring
+    /// file `stream` sets it from `[rings] track_leg_toes`.
+    #[serde(skip)]
+    pub leg_toes: bool,
     /// Longest stretch, metres, a track follows a curb cut's toe on virtual profiles
     /// (`profile::Profile::cut_toe`: the break of slope where the lip is under
     /// `profile_min_step_m`, down to none) after the bend angle and the step have both
@@ -230,6 +235,7 @@ impl Default for BendParams {
             profile_max_slope: 0.1,
             profile_max_road_fall: 0.15,
             profile_seed_reach_m: 15.0,
+            leg_toes: true,
             cut_follow_max_m: 15.0,
             weak_rho_deg: 30.0,
             weak_run_max_m: 1.5,

@@ -573,7 +573,12 @@ fn track_one_way(
                             .flatten()
                     })
                     .or_else(|| sparse_toe(&long, &picked))
-                    .or_else(|| leg_toe(&profile, &picked));
+                    .or_else(|| {
+                        params
+                            .leg_toes
+                            .then(|| leg_toe(&profile, &picked))
+                            .flatten()
+                    });
                 // Neither ρ nor a step: a curb cut's toe continues the curb's line as a
                 // break of slope, followed for at most `cut_follow_max_m`, and only by a
                 // track that has followed a curb before it.

@@ -432,12 +432,13 @@ pub(super) fn stage_window(window: &WindowParams, cfg: &Config, rings: bool) -> 
 }
 
 /// The bend method's parameters for a stage's output: `[bend]`, with the tracker's search
-/// radius and stop threshold from `[rings]` (`track_*`) when `rings`.
+/// radius, stop threshold and far-leg toes from `[rings]` (`track_*`) when `rings`.
 pub(super) fn stage_bend(cfg: &Config, rings: bool) -> crate::bend::BendParams {
     let mut bend = cfg.bend.clone();
     if rings {
         bend.search_radius_m = f64::from(cfg.rings.track_search_radius_m);
         bend.stop_rho_deg = f64::from(cfg.rings.track_stop_rho_deg);
+        bend.leg_toes = cfg.rings.track_leg_toes;
     }
     bend
 }
