@@ -10,6 +10,7 @@
 
 use super::claims::{Claims, Join};
 use super::climb::{climbed_toe, CLIMBED_SHARE};
+use super::face::face_toe_or_longer;
 use super::grid::PointGrid;
 use super::leg::leg_toe;
 use super::params::{widened, BendParams};
@@ -577,6 +578,15 @@ fn track_one_way(
                         params
                             .leg_toes
                             .then(|| leg_toe(&profile, &picked))
+                            .flatten()
+                    })
+                    // On rings (the only input with a view past the points' ends), a face
+                    // a ring slides along.
+                    .or_else(|| {
+                        params
+                            .end_view
+                            .is_some()
+                            .then(|| face_toe_or_longer(&profile))
                             .flatten()
                     });
                 // Neither ρ nor a step: a curb cut's toe continues the curb's line as a

@@ -217,6 +217,9 @@ pub struct ArcCounters {
     pub skipped_no_road: u32,
     /// Half-arcs skipped: pseudo-nadir beyond the reach.
     pub skipped_far: u32,
+    /// Points within the reach of the sensor of half-arcs skipped beyond it, kept for the
+    /// virtual profiles without a bend angle (the streaming stage only).
+    pub points_far: u64,
     /// Points left out as too near.
     pub points_near: u64,
     /// Points left out as too far to the side.
