@@ -306,11 +306,12 @@ impl Summary {
 /// was left out (docs/spec.md §2, *What is left out*).
 fn arcs_text(a: &crate::rings::ArcCounters) -> String {
     format!(
-        " (half-arcs of {rings} rings; skipped: {short} short, {road} without road at the centre line, {far} beyond the reach; points left out: {near} near, {lat} beyond the side, {piled} piled up)",
+        " (half-arcs of {rings} rings; skipped: {short} short, {road} without road at the centre line, {far} beyond the reach, their {far_pts} points within it kept for profiles only; points left out: {near} near, {lat} beyond the side, {piled} piled up)",
         rings = a.rings,
         short = a.skipped_short,
         road = a.skipped_no_road,
         far = a.skipped_far,
+        far_pts = a.points_far,
         near = a.points_near,
         lat = a.points_lateral,
         piled = a.points_piled,

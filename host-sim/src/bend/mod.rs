@@ -15,6 +15,7 @@ use crate::replay::{Candidate, PointStatus};
 pub mod bridge;
 pub mod claims;
 pub mod climb;
+pub mod face;
 pub mod grid;
 pub mod leg;
 pub mod params;
@@ -26,7 +27,7 @@ pub mod shadow;
 pub mod sparse;
 pub mod track;
 
-pub use params::BendParams;
+pub use params::{BendParams, EndView};
 
 /// Everything the host half of the bend method reads. All slices are indexed by point
 /// (the columns of `io::las_in`, sorted by time).
@@ -165,6 +166,7 @@ pub fn extract_edges_on_grid(
     let mut seeds = seed::seed_points(&input, route, params);
     let from_profiles = seed::profile_seeds(&input, grid, route, params);
     seeds.extend(from_profiles);
+    seeds.extend(seed::end_seeds(&input, grid, route, params));
     // Best-fitting seeds first: the first track along a curb claims it, later seeds on the
     // same curb start nothing.
     seeds.sort_by(|a, b| {

@@ -109,6 +109,16 @@ pub struct BendParams {
     /// is there between the scanlines. 15 m reaches the far curb of a 14 m road from the
     /// near lane.
     pub profile_seed_reach_m: f64,
+    /// Whether a track whose ordinary profiles see no toe tries the far leg's longer
+    /// profile (`leg::leg_toe`). Not a `[bend]` setting: on profilers it is on; on a ring
+    /// file `stream` sets it from `[rings] track_leg_toes`.
+    #[serde(skip)]
+    pub leg_toes: bool,
+    /// Where a spinning sensor's rings see the road past the two ends of the points, for
+    /// the seeds of [`super::seed::end_seeds`]; `None` (the default, and on profilers)
+    /// seeks none. Not a `[bend]` setting: `stream` sets it from `[rings]` on a ring file.
+    #[serde(skip)]
+    pub end_view: Option<EndView>,
     /// Longest stretch, metres, a track follows a curb cut's toe on virtual profiles
     /// (`profile::Profile::cut_toe`: the break of slope where the lip is under
     /// `profile_min_step_m`, down to none) after the bend angle and the step have both
@@ -230,6 +240,8 @@ impl Default for BendParams {
             profile_max_slope: 0.1,
             profile_max_road_fall: 0.15,
             profile_seed_reach_m: 15.0,
+            leg_toes: true,
+            end_view: None,
             cut_follow_max_m: 15.0,
             weak_rho_deg: 30.0,
             weak_run_max_m: 1.5,
@@ -254,6 +266,19 @@ impl Default for BendParams {
             min_category_run_m: 1.0,
         }
     }
+}
+
+/// The road a spinning sensor sees from each end of its points: the ring points kept from
+/// `near_m` to `reach_m` horizontally from the sensor, within `max_azimuth_deg` of straight
+/// ahead (at the end) or behind (at the start).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EndView {
+    /// Nearest horizontal range of the ring points kept, metres.
+    pub near_m: f64,
+    /// Farthest range of the ring points kept, metres.
+    pub reach_m: f64,
+    /// Largest azimuth from the vehicle's axis of the points kept, degrees.
+    pub max_azimuth_deg: f64,
 }
 
 /// How much wider than `profile_half_width_m` a widened profile is, metres.

@@ -10,6 +10,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
+use super::face::face_toe_or_longer;
 use super::grid::PointGrid;
 use super::params::{widened, BendParams};
 use super::profile::{usable, Profile};
@@ -168,7 +169,8 @@ pub fn profile_seeds(
                 let mut heights = Heights::new(params.profile_half_width_m);
                 let mut first = |params: &BendParams, half_l: f64| {
                     let h = &mut heights;
-                    first_toe_outward(input, grid, p, fwd, n, up, half_l, reach, params, h)
+                    let range = (PROFILE_SEED_NEAR_M, reach);
+                    first_toe_outward(input, grid, p, fwd, n, up, half_l, range, false, params, h)
                 };
                 first(params, half_l)
                     .or_else(|| first(&wide, half_l))
@@ -238,9 +240,10 @@ impl Heights {
 }
 
 /// The seed point of the first toe that profiles across `fwd` find outward along `n` from
-/// `p`, from [`PROFILE_SEED_NEAR_M`] to `reach` every [`PROFILE_SEED_STEP_M`] (see
-/// [`profile_seeds`]): the usable point nearest to it; `None` where the first toe has none
-/// within the search radius, or there is no toe. The ground heights come from `heights`.
+/// `p`, from `near` to `reach` every [`PROFILE_SEED_STEP_M`] (see [`profile_seeds`]), by
+/// `profile::Profile::toe`, else `face::face_toe_or_longer` when `ring`: the usable point nearest to it;
+/// `None` where the first toe has none within the search radius, or there is no toe. The
+/// ground heights come from `heights`.
 #[allow(clippy::too_many_arguments)]
 fn first_toe_outward(
     input: &BendInput,
@@ -250,11 +253,12 @@ fn first_toe_outward(
     n: [f64; 2],
     up: f64,
     half_l: f64,
-    reach: f64,
+    (near, reach): (f64, f64),
+    ring: bool,
     params: &BendParams,
     heights: &mut Heights,
 ) -> Option<u32> {
-    let mut c = PROFILE_SEED_NEAR_M;
+    let mut c = near;
     let mut k = 0;
     while c <= reach {
         let centre = [p[0] + c * n[0], p[1] + c * n[1]];
@@ -273,12 +277,115 @@ fn first_toe_outward(
             up,
             half_l,
         };
-        let Some(toe) = profile.toe() else {
+        let toe = if ring {
+            profile.toe().or_else(|| face_toe_or_longer(&profile))
+        } else {
+            profile.toe()
+        };
+        let Some(toe) = toe else {
             continue;
         };
         return nearest_usable(input, grid, toe.xyz, params.search_radius_m);
     }
     None
+}
+
+/// Seeds from radial profiles at the two ends of the input's points, for a spinning
+/// sensor (`params.end_view`; none without it), one per ray at most.
+///
+/// A ring is a cone about the sensor: where a curb's face lies at nearly one range from it
+/// (a side street's far corner ahead, convex towards the sensor) the ring meets the face at
+/// the height that range gives and runs along it, so no ring crosses that curb, no bend
+/// angle peaks and the core gives no candidate. Within the route a later station passes
+/// such a curb and its rings cross it from beside; past the last point's station (and
+/// behind the first's) none does, and [`profile_seeds`] looks only across the driving
+/// direction between them. There the direction from the sensor crosses the face: from the
+/// route's pose at the last point's time, rays ahead within `max_azimuth_deg` of the axis
+/// (behind it at the first point's), [`radial_step_deg`] apart, are searched outward from
+/// `near_m` to `reach_m` by profiles across the ray every [`PROFILE_SEED_STEP_M`]
+/// (`Profile::toe`, else `face::face_toe_or_longer`, as a ring slides along that face); the first
+/// toe on a ray gives a seed on the point nearest to it, its
+/// direction the profile's length oriented with the driving direction, its side the side
+/// of the axis it lies on. These seeds come last in tracking, as the profile seeds.
+pub fn end_seeds(
+    input: &BendInput,
+    grid: &PointGrid,
+    route: &Route,
+    params: &BendParams,
+) -> Vec<Seed> {
+    let Some(view) = params.end_view else {
+        return Vec::new();
+    };
+    let finite_t = || input.t.iter().copied().filter(|t| t.is_finite());
+    let (Some(t0), Some(t1)) = (finite_t().reduce(f64::min), finite_t().reduce(f64::max)) else {
+        return Vec::new();
+    };
+    let (Some(s0), Some(s1)) = (route.arc_at(t0), route.arc_at(t1)) else {
+        return Vec::new();
+    };
+    let l_s = params.seed_interval_m.max(1e-3);
+    let half_l = 2.0 * params.profile_half_length_m;
+    let step = radial_step_deg(half_l, view.reach_m);
+    if !(step > 0.0 && view.max_azimuth_deg.is_finite() && view.near_m <= view.reach_m) {
+        return Vec::new();
+    }
+    let k_max = (view.max_azimuth_deg.clamp(0.0, 90.0) / step).floor() as i64;
+    // (station, −1 behind the first point's, +1 ahead of the last point's)
+    let mut rays = Vec::new();
+    for (s, look) in [(s0, -1.0), (s1, 1.0)] {
+        let Some((p, fwd)) = route.pose_at_arc(s) else {
+            continue;
+        };
+        let interval = (s / l_s).floor() as i64;
+        for k in -k_max..=k_max {
+            let (sin, cos) = (k as f64 * step).to_radians().sin_cos();
+            let axis = [look * fwd[0], look * fwd[1]];
+            let ray = [axis[0] * cos - axis[1] * sin, axis[0] * sin + axis[1] * cos];
+            rays.push((p, fwd, ray, interval));
+        }
+    }
+    rays.par_iter()
+        .filter_map(|&(p, fwd, ray, interval)| {
+            // Across the profile runs along the ray, away from the sensor (`up` = +1).
+            let along = [ray[1], -ray[0]];
+            let range = (view.near_m, view.reach_m);
+            let h = &mut Heights::new(params.profile_half_width_m);
+            let point = first_toe_outward(
+                input, grid, p, along, ray, 1.0, half_l, range, true, params, h,
+            )?;
+            let i = point as usize;
+            let (dx, dy) = (input.x[i] - p[0], input.y[i] - p[1]);
+            let side = if fwd[0] * dy - fwd[1] * dx >= 0.0 {
+                Side::Left
+            } else {
+                Side::Right
+            };
+            let dir = if along[0] * fwd[0] + along[1] * fwd[1] < 0.0 {
+                [-along[0], -along[1]]
+            } else {
+                along
+            };
+            Some(Seed {
+                point,
+                side,
+                dir,
+                interval,
+                inlier_ratio: 0.0,
+            })
+        })
+        .collect()
+}
+
+/// Azimuth between the rays of [`end_seeds`], degrees: profiles `half_l` long either side
+/// of their ray touch their neighbours' at `reach_m`, so no stretch within the reach lies
+/// between two rays; 0 where that has no meaning.
+pub fn radial_step_deg(half_l: f64, reach_m: f64) -> f64 {
+    let step = (2.0 * half_l / reach_m).to_degrees();
+    if step.is_finite() && step > 0.0 {
+        step
+    } else {
+        0.0
+    }
 }
 
 /// Median height of the usable points within `r` (horizontal) of `centre`; `None` with
@@ -456,6 +563,17 @@ mod tests {
     use super::*;
     use crate::bend::fixture::KeptPoints;
 
+    #[test]
+    fn end_rays_leave_no_stretch_within_the_reach_unseen() {
+        // Profiles 0.3 m either side of their ray touch at 20 m: 0.6 m of arc, 1.72°.
+        let step = radial_step_deg(0.3, 20.0);
+        assert!((step - 1.7189).abs() < 1e-3, "{step}");
+        let arc_at_reach = step.to_radians() * 20.0;
+        assert!((arc_at_reach - 0.6).abs() < 1e-9);
+        assert_eq!(radial_step_deg(0.3, 0.0), 0.0);
+        assert_eq!(radial_step_deg(0.0, 20.0), 0.0);
+    }
+
     /// 30 points on y = 0.5·x + 3 (x from 0 to 2.9 m, far from the origin), every third
     /// one moved 0.3–1.2 m off the line.
     fn line_with_outliers() -> (Vec<f64>, Vec<f64>) {
@@ -560,7 +678,8 @@ mod tests {
                     [0.0, 1.0],
                     1.0,
                     half_l,
-                    15.0,
+                    (PROFILE_SEED_NEAR_M, 15.0),
+                    false,
                     p,
                     &mut Heights::new(params.profile_half_width_m),
                 );

@@ -10,6 +10,7 @@
 
 use super::claims::{Claims, Join};
 use super::climb::{climbed_toe, CLIMBED_SHARE};
+use super::face::face_toe_or_longer;
 use super::grid::PointGrid;
 use super::leg::leg_toe;
 use super::params::{widened, BendParams};
@@ -573,7 +574,21 @@ fn track_one_way(
                             .flatten()
                     })
                     .or_else(|| sparse_toe(&long, &picked))
-                    .or_else(|| leg_toe(&profile, &picked));
+                    .or_else(|| {
+                        params
+                            .leg_toes
+                            .then(|| leg_toe(&profile, &picked))
+                            .flatten()
+                    })
+                    // On rings (the only input with a view past the points' ends), a face
+                    // a ring slides along.
+                    .or_else(|| {
+                        params
+                            .end_view
+                            .is_some()
+                            .then(|| face_toe_or_longer(&profile))
+                            .flatten()
+                    });
                 // Neither ρ nor a step: a curb cut's toe continues the curb's line as a
                 // break of slope, followed for at most `cut_follow_max_m`, and only by a
                 // track that has followed a curb before it.

@@ -123,6 +123,13 @@ pub struct ArcParams {
     /// on a profiler's dense scanlines. Measured on the tuning drives (docs/results.md,
     /// *Spinning lidars*).
     pub track_stop_rho_deg: f32,
+    /// Whether the tracker tries the far leg's longer profile on rings (`bend::leg`;
+    /// always on profilers). false: a ring crosses a curb every few decimetres along it
+    /// wherever it sees it at all, so a profile too sparse for the ordinary test lies
+    /// between two crossings, and the one four times as long reaches whatever step lies
+    /// beyond them. Measured on the tuning and evaluation drives (docs/results.md,
+    /// *Spinning lidars*).
+    pub track_leg_toes: bool,
 }
 
 impl Default for ArcParams {
@@ -137,6 +144,7 @@ impl Default for ArcParams {
             min_separation_m: 0.01,
             track_search_radius_m: 0.07,
             track_stop_rho_deg: 20.0,
+            track_leg_toes: false,
         }
     }
 }
@@ -209,6 +217,9 @@ pub struct ArcCounters {
     pub skipped_no_road: u32,
     /// Half-arcs skipped: pseudo-nadir beyond the reach.
     pub skipped_far: u32,
+    /// Points within the reach of the sensor of half-arcs skipped beyond it, kept for the
+    /// virtual profiles without a bend angle (the streaming stage only).
+    pub points_far: u64,
     /// Points left out as too near.
     pub points_near: u64,
     /// Points left out as too far to the side.

@@ -431,13 +431,20 @@ pub(super) fn stage_window(window: &WindowParams, cfg: &Config, rings: bool) -> 
     }
 }
 
-/// The bend method's parameters for a stage's output: `[bend]`, with the tracker's search
-/// radius and stop threshold from `[rings]` (`track_*`) when `rings`.
+/// The bend method's parameters for a stage's output: `[bend]`, with, when `rings`, the
+/// tracker's search radius, stop threshold and far-leg toes from `[rings]` (`track_*`) and
+/// the view past the points' ends from the half-arc cut's limits (`bend::seed::end_seeds`).
 pub(super) fn stage_bend(cfg: &Config, rings: bool) -> crate::bend::BendParams {
     let mut bend = cfg.bend.clone();
     if rings {
         bend.search_radius_m = f64::from(cfg.rings.track_search_radius_m);
         bend.stop_rho_deg = f64::from(cfg.rings.track_stop_rho_deg);
+        bend.leg_toes = cfg.rings.track_leg_toes;
+        bend.end_view = Some(crate::bend::EndView {
+            near_m: f64::from(cfg.rings.min_range_m),
+            reach_m: f64::from(cfg.rings.max_reach_m),
+            max_azimuth_deg: f64::from(cfg.rings.max_azimuth_deg),
+        });
     }
     bend
 }
@@ -789,10 +796,14 @@ mod stage_tests {
             b.search_radius_m
         );
         assert_eq!(b.stop_rho_deg, 22.5);
+        let view = b.end_view.expect("rings see past the points' ends");
+        assert_eq!(view.reach_m, f64::from(cfg.rings.max_reach_m));
+        assert_eq!(view.max_azimuth_deg, f64::from(cfg.rings.max_azimuth_deg));
         // Nothing else changes.
         let back = crate::bend::BendParams {
             search_radius_m: cfg.bend.search_radius_m,
             stop_rho_deg: cfg.bend.stop_rho_deg,
+            end_view: None,
             ..b
         };
         assert_eq!(back, cfg.bend);

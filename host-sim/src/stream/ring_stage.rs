@@ -182,6 +182,15 @@ pub fn estimate_sensor(b: &PointBatch, traj: &Trajectory) -> Option<SensorModel>
     })
 }
 
+/// What [`RingStage::accept`] keeps of a run.
+enum Accepted {
+    /// A half-arc for the core.
+    Arc(Vec<RunPoint>),
+    /// The points within `max_reach_m` of the sensor of a half-arc that meets the centre
+    /// line beyond it.
+    Far(Vec<RunPoint>),
+}
+
 /// The carried index of a run's last point.
 fn last_index(r: &Run) -> usize {
     r.points.last().map_or(0, |q| q.i as usize)
@@ -469,9 +478,11 @@ impl<'a> RingStage<'a> {
         self.arcs.points_near += left_out[..cut].iter().filter(|&&f| f == 1).count() as u64;
         self.arcs.points_lateral += left_out[..cut].iter().filter(|&&f| f == 2).count() as u64;
         let mut arcs: Vec<Vec<RunPoint>> = Vec::with_capacity(closed.len());
+        let mut far: Vec<Vec<RunPoint>> = Vec::new();
         for r in closed {
             match self.accept(r) {
-                Ok(a) => arcs.push(a),
+                Ok(Accepted::Arc(a)) => arcs.push(a),
+                Ok(Accepted::Far(a)) => far.push(a),
                 Err(mut spare) => {
                     spare.clear();
                     self.spare.push(spare);
@@ -479,8 +490,8 @@ impl<'a> RingStage<'a> {
             }
         }
         let kernel = self.kernel.unwrap_or_else(|| sensor.kernel_params());
-        let out = self.run_core(&arcs, &sensor, &kernel, cut)?;
-        self.spare.extend(arcs.into_iter().map(|mut a| {
+        let out = self.run_core(&arcs, &far, &sensor, &kernel, cut)?;
+        self.spare.extend(arcs.into_iter().chain(far).map(|mut a| {
             a.clear();
             a
         }));
@@ -491,8 +502,10 @@ impl<'a> RingStage<'a> {
     }
 
     /// Thinning and the road checks of one run (`rings::arc`'s rule): the arc's points, or
-    /// the run's buffer back when the run is skipped.
-    fn accept(&mut self, r: Run) -> Result<Vec<RunPoint>, Vec<RunPoint>> {
+    /// for an arc that sees the road at the centre line beyond `max_reach_m`, its points
+    /// within `max_reach_m` of the sensor ([`Accepted::Far`]); the run's buffer back when
+    /// the run is skipped.
+    fn accept(&mut self, r: Run) -> Result<Accepted, Vec<RunPoint>> {
         let p = &self.arc;
         let c = &mut self.arcs;
         if r.points.len() < p.min_points {
@@ -536,18 +549,26 @@ impl<'a> RingStage<'a> {
         }
         if nadir.x.abs() > p.max_reach_m {
             c.skipped_far += 1;
-            return Err(pts);
+            let reach2 = p.max_reach_m * p.max_reach_m;
+            pts.retain(|q| q.b.x * q.b.x + q.b.y * q.b.y <= reach2);
+            if pts.is_empty() {
+                return Err(pts);
+            }
+            c.points_far += pts.len() as u64;
+            return Ok(Accepted::Far(pts));
         }
         c.arcs += 1;
         c.points_in_arcs += pts.len() as u64;
-        Ok(pts)
+        Ok(Accepted::Arc(pts))
     }
 
     /// Runs `arcs` through a fresh pipeline (`rings::run`: config packet first, one line
-    /// per arc) and returns the first `cut` carried points with the core's output.
+    /// per arc) and returns the first `cut` carried points with the core's output; the
+    /// points of the `far` arcs follow, one line each, kept without a bend angle.
     fn run_core(
         &mut self,
         arcs: &[Vec<RunPoint>],
+        far: &[Vec<RunPoint>],
         sensor: &SensorModel,
         kernel: &KernelParams,
         cut: usize,
@@ -613,6 +634,20 @@ impl<'a> RingStage<'a> {
             ArcRunError::Encode(e) => CoreError::Replay(ReplayError::Encode(e)),
             ArcRunError::Stalled => CoreError::Replay(ReplayError::Stalled),
         })?;
+        // A far arc's bend angles would be read on pieces of a ring cut off at the reach,
+        // without the road at the centre line the outward search starts from: its points
+        // serve the virtual profiles only (`bend::profile::usable`).
+        for arc in far {
+            let line = base_line + line_no;
+            line_no += 1;
+            for q in arc {
+                let j = q.i as usize;
+                if j < cut {
+                    status[j] = Some(PointStatus::NoNeighbour);
+                    scanline[j] = line;
+                }
+            }
+        }
         counters.packets += sent.packets;
         counters.bytes += sent.bytes;
         counters.points_sent += sent.points;
@@ -802,6 +837,59 @@ mod tests {
             assert_eq!(bits(frames.body(x, y, z, t)), bits(fresh), "t = {t}");
         }
         assert!(frames.body(1.0, 1.0, 1.0, 99.0).is_none());
+    }
+
+    #[test]
+    fn a_far_arc_keeps_its_points_within_the_reach_for_profiles_only() {
+        // The fixture's outermost laser meets the road 15 m out; on the left beyond the
+        // kerb (x < −3) it meets the raised ground 11 m out. With a 14 m reach its
+        // half-arcs reach the centre line beyond it.
+        let mut b = stream(2);
+        let far = (RINGS - 1) as u8;
+        for i in 0..b.len() {
+            if b.channel[i] == far && b.x[i] < -3.0 {
+                let k = 11.0 / b.x[i].hypot(b.y[i]);
+                b.x[i] *= k;
+                b.y[i] *= k;
+            }
+        }
+        let tr: &'static Trajectory = Box::leak(Box::new(traj()));
+        let arc = ArcParams {
+            max_reach_m: 14.0,
+            ..ArcParams::default()
+        };
+        let mut st = RingStage::new(tr, arc, None);
+        let mut out = Vec::new();
+        out.extend(st.push(b.clone()).expect("stage runs"));
+        out.extend(st.finish().expect("stage finishes"));
+        let (mut kept_far, mut beyond) = (0, 0);
+        for c in &out {
+            for (k, s) in c.status.iter().enumerate() {
+                let g = c.base as usize + k;
+                if b.channel[g] != far {
+                    continue;
+                }
+                if b.x[g].hypot(b.y[g]) <= 14.0 {
+                    // Kept without a bend angle, never a candidate.
+                    if s.is_some() {
+                        assert_eq!(*s, Some(PointStatus::NoNeighbour));
+                        kept_far += 1;
+                    }
+                } else {
+                    assert!(s.is_none(), "a point beyond the reach is kept");
+                    beyond += 1;
+                }
+            }
+            for k in &c.candidates {
+                assert_ne!(b.channel[c.base as usize + k.point as usize], far);
+            }
+        }
+        assert!(
+            kept_far > 100 && beyond > 100,
+            "{kept_far} kept, {beyond} beyond"
+        );
+        assert!(st.arc_counters().skipped_far >= 2);
+        assert_eq!(st.arc_counters().points_far, kept_far);
     }
 
     #[test]
