@@ -91,6 +91,13 @@ pub fn face_toe(profile: &Profile) -> Option<ProfileToe> {
     if pts.len() < 2 * MIN_SIDE {
         return None;
     }
+    // In one order whatever order the grid hands the points over in (it differs between a
+    // whole run and a campaign's tasks), so the sums below give the same bits.
+    pts.sort_by(|p, q| {
+        (p.0.total_cmp(&q.0))
+            .then(p.1.total_cmp(&q.1))
+            .then(p.2.total_cmp(&q.2))
+    });
     // The road's height: the lowest tenth of the returns.
     let mut zs: Vec<f64> = pts.iter().map(|p| p.1).collect();
     zs.sort_by(f64::total_cmp);
