@@ -390,6 +390,8 @@ impl<'a> SectionWindow<'a> {
         let mut k = 0;
         // The forward vector of sample `k`, computed once per sample (a sine and a cosine).
         let mut forward: Option<(usize, [f64; 2])> = None;
+        // The route's sample cursor for the points' stations.
+        let mut arc = 0;
         for i in c.side()..n {
             // The trajectory's sample at or before the point's time (points come in time
             // order, so the cursor only moves on).
@@ -414,7 +416,7 @@ impl<'a> SectionWindow<'a> {
             let ahead = dx * fx + dy * fy;
             let aside = dx * fy - dy * fx;
             if ahead <= lead_max && aside.abs() <= SIDE_ASIDE_M {
-                let sp = self.station(t) + ahead;
+                let sp = self.route.arc_at_from(t, &mut arc).unwrap_or(0.0) + ahead;
                 if sp >= from {
                     keep.push(i, sp);
                 }
