@@ -68,21 +68,52 @@ impl Route {
         if n == 1 {
             return Some((0, 0.0));
         }
-        let k = self.t.partition_point(|&u| u <= t).clamp(1, n - 1);
+        Some(self.bracket_after(t, self.t.partition_point(|&u| u <= t)))
+    }
+
+    /// The bracket of a finite time `t` on a route of two or more samples, `after` of
+    /// which lie at or before it.
+    fn bracket_after(&self, t: f64, after: usize) -> (usize, f64) {
+        let k = after.clamp(1, self.t.len() - 1);
         let (a, b) = (self.t[k - 1], self.t[k]);
         let w = if b > a {
             ((t - a) / (b - a)).clamp(0.0, 1.0)
         } else {
             0.0
         };
-        Some((k - 1, w))
+        (k - 1, w)
     }
 
     /// Arc length along the route at time `t`, metres (clamped to the covered range).
     pub fn arc_at(&self, t: f64) -> Option<f64> {
         let (k, w) = self.bracket(t)?;
+        Some(self.arc_in(k, w))
+    }
+
+    /// [`arc_at`](Self::arc_at) for times that seldom go back from one call to the next:
+    /// `cursor` (0 at first) keeps how many samples lay at or before the last time, and
+    /// the search walks on from there instead of bisecting every sample.
+    pub fn arc_at_from(&self, t: f64, cursor: &mut usize) -> Option<f64> {
+        let n = self.t.len();
+        if n < 2 || !t.is_finite() {
+            return self.arc_at(t);
+        }
+        let mut after = (*cursor).min(n);
+        if after > 0 && self.t[after - 1] > t {
+            after = self.t.partition_point(|&u| u <= t);
+        }
+        while after < n && self.t[after] <= t {
+            after += 1;
+        }
+        *cursor = after;
+        let (k, w) = self.bracket_after(t, after);
+        Some(self.arc_in(k, w))
+    }
+
+    /// The arc length a fraction `w` of the way from sample `k` to the next.
+    fn arc_in(&self, k: usize, w: f64) -> f64 {
         let next = (k + 1).min(self.s.len() - 1);
-        Some(self.s[k] + (self.s[next] - self.s[k]) * w)
+        self.s[k] + (self.s[next] - self.s[k]) * w
     }
 
     /// Horizontal position and forward unit vector where the route's arc length is `s`
@@ -355,6 +386,20 @@ mod tests {
         assert_eq!(r.arc_at(50.0), Some(0.0));
         let f = r.forward_at(104.0).unwrap();
         assert!((f[0] - 1.0).abs() < 1e-12 && f[1].abs() < 1e-12);
+    }
+
+    #[test]
+    fn arc_from_a_cursor_is_the_arc_at_the_time() {
+        let r = east_route();
+        // On samples, between them, before and after the route, going back, and NaN.
+        let on_and_between = [99.0, 100.0, 100.5, 101.0, 101.0, 104.7, 103.2, 103.2];
+        let past_and_back = [109.99, 110.0, 111.0, 100.1, f64::NAN, 105.5];
+        let mut cursor = 0;
+        for t in on_and_between.into_iter().chain(past_and_back) {
+            let want = r.arc_at(t).map(f64::to_bits);
+            assert_eq!(r.arc_at_from(t, &mut cursor).map(f64::to_bits), want, "{t}");
+        }
+        assert_eq!(r.arc_at_from(103.25, &mut cursor), Some(32.5));
     }
 
     #[test]

@@ -127,6 +127,35 @@ impl Keep {
             .get(i / 64)
             .is_some_and(|w| w >> (i % 64) & 1 == 1)
     }
+
+    /// The runs of consecutive kept points among the first `n`, in order.
+    fn runs(&self, n: usize) -> Vec<std::ops::Range<usize>> {
+        let bits_from = |i: usize| self.bits.get(i / 64).map_or(0, |w| w >> (i % 64));
+        let mut runs = Vec::new();
+        let mut i = 0;
+        while i < n {
+            let w = bits_from(i);
+            if w == 0 {
+                // No kept point in the rest of this word.
+                i = (i / 64 + 1) * 64;
+                continue;
+            }
+            i += w.trailing_zeros() as usize;
+            let start = i;
+            // A run that fills the rest of its word goes on into the next.
+            loop {
+                let ones = bits_from(i).trailing_ones() as usize;
+                i += ones;
+                if ones == 0 || i % 64 != 0 {
+                    break;
+                }
+            }
+            if start < n {
+                runs.push(start..i.min(n));
+            }
+        }
+        runs
+    }
 }
 
 impl Columns {
@@ -203,13 +232,14 @@ impl Columns {
         let kept = keep.sp.len();
         let mut sp = std::mem::take(&mut keep.sp);
         sp.extend_from_slice(&self.side_sp[n.min(side)..]);
-        compact(&mut self.x, &keep, n);
-        compact(&mut self.y, &keep, n);
-        compact(&mut self.z, &keep, n);
-        compact(&mut self.t, &keep, n);
-        compact(&mut self.rho, &keep, n);
-        compact(&mut self.status, &keep, n);
-        compact(&mut self.scanline, &keep, n);
+        let runs = keep.runs(n);
+        compact(&mut self.x, &runs, n);
+        compact(&mut self.y, &runs, n);
+        compact(&mut self.z, &runs, n);
+        compact(&mut self.t, &runs, n);
+        compact(&mut self.rho, &runs, n);
+        compact(&mut self.status, &runs, n);
+        compact(&mut self.scanline, &runs, n);
         self.base += n.saturating_sub(side) as u64;
         self.side_sp = sp;
         let new_front = self.gid(0);
@@ -234,15 +264,13 @@ impl Columns {
     }
 }
 
-/// Moves the points `keep` holds among the first `n` of `v` to the front, in order, and
-/// drops the rest of those `n`.
-fn compact<T: Copy>(v: &mut Vec<T>, keep: &Keep, n: usize) {
+/// Moves the runs `runs` of the first `n` points of `v` (in order, within `0..n`) to the
+/// front, in order, and drops the rest of those `n`.
+fn compact<T: Copy>(v: &mut Vec<T>, runs: &[std::ops::Range<usize>], n: usize) {
     let mut w = 0;
-    for i in 0..n {
-        if keep.has(i) {
-            v[w] = v[i];
-            w += 1;
-        }
+    for r in runs {
+        v.copy_within(r.clone(), w);
+        w += r.len();
     }
     v.drain(w..n);
 }
@@ -390,6 +418,8 @@ impl<'a> SectionWindow<'a> {
         let mut k = 0;
         // The forward vector of sample `k`, computed once per sample (a sine and a cosine).
         let mut forward: Option<(usize, [f64; 2])> = None;
+        // The route's sample cursor for the points' stations.
+        let mut arc = 0;
         for i in c.side()..n {
             // The trajectory's sample at or before the point's time (points come in time
             // order, so the cursor only moves on).
@@ -414,7 +444,7 @@ impl<'a> SectionWindow<'a> {
             let ahead = dx * fx + dy * fy;
             let aside = dx * fy - dy * fx;
             if ahead <= lead_max && aside.abs() <= SIDE_ASIDE_M {
-                let sp = self.station(t) + ahead;
+                let sp = self.route.arc_at_from(t, &mut arc).unwrap_or(0.0) + ahead;
                 if sp >= from {
                     keep.push(i, sp);
                 }
@@ -811,6 +841,25 @@ mod tests {
             scanline: vec![0; n],
             candidates: Vec::new(),
         }
+    }
+
+    #[test]
+    fn kept_runs_are_the_kept_points() {
+        let n = 300;
+        // Runs inside a word, across word boundaries, to the last point, and one point.
+        let kept = |i: usize| (3..9).contains(&i) || (60..200).contains(&i) || i == 250 || i >= 298;
+        let mut keep = Keep::new(n);
+        for i in (0..n).filter(|&i| kept(i)) {
+            keep.push(i, 0.0);
+        }
+        let runs = keep.runs(n);
+        assert_eq!(runs, vec![3..9, 60..200, 250..251, 298..300]);
+        assert_eq!(keep.runs(100), vec![3..9, 60..100]);
+        assert_eq!(Keep::new(0).runs(n), vec![]);
+        let mut v: Vec<usize> = (0..n + 5).collect();
+        compact(&mut v, &runs, n);
+        let want: Vec<usize> = (0..n).filter(|&i| kept(i)).chain(n..n + 5).collect();
+        assert_eq!(v, want);
     }
 
     fn drive(max_s: f64) -> SectionWindow<'static> {
