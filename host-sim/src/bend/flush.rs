@@ -12,6 +12,8 @@
 //! hinge would draw the break towards the road by the lip over the turn in slope. Meant
 //! only for a track already following a cut, on the line it predicts.
 
+use std::cmp::Ordering;
+
 use super::profile::{Profile, ProfileToe, Sums};
 use super::track::{FlushTail, Track};
 
@@ -88,7 +90,7 @@ fn hinge_at(sums: &Sums, k: usize, t: f64, h: f64) -> Option<Hinge> {
     // Normal matrix [[n, a1, a2], [a1, b1q, 0], [a2, 0, b2q]] and its right-hand side.
     let rhs = [sz, l[4], r[4]];
     let det = n * b1q * b2q - a1 * a1 * b2q - a2 * a2 * b1q;
-    if !(det.abs() > 1e-12 * n.powi(3).max(1.0)) {
+    if det.abs().partial_cmp(&(1e-12 * n.powi(3).max(1.0))) != Some(Ordering::Greater) {
         return None;
     }
     // The inverse by cofactors (symmetric).
@@ -124,7 +126,7 @@ fn stepped_hinge_at(sums: &Sums, k: usize, t: f64) -> Option<Hinge> {
     // A free line z = a + b·(c − t) on each side.
     let line = |s: &[f64; 6]| -> Option<(f64, f64, f64)> {
         let den = s[0] * s[2] - s[1] * s[1];
-        if !(den > 1e-12 * s[0] * s[0]) {
+        if den.partial_cmp(&(1e-12 * s[0] * s[0])) != Some(Ordering::Greater) {
             return None;
         }
         let b = (s[0] * s[4] - s[1] * s[3]) / den;

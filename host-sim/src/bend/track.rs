@@ -151,7 +151,7 @@ pub fn track_edges_with_tails(
             .sum();
         if length < FLUSH_HOLD_MIN_M {
             verts.splice(0..0, bwd_tail.iter().rev().copied());
-            verts.extend(fwd_tail.drain(..));
+            verts.append(&mut fwd_tail);
             bwd_tail.clear();
         }
         let points: Vec<u32> = verts.iter().map(|v| v.0).collect();
@@ -508,13 +508,17 @@ fn unit3(v: [f64; 3]) -> Option<[f64; 3]> {
     (l > 1e-9).then(|| [v[0] / l, v[1] / l, v[2] / l])
 }
 
+/// A track's vertices as (id, position) pairs.
+type Vertices = Vec<(u32, [f64; 3])>;
+
 /// Tracks from `start` along `dir0` until the stop rule of §2.7 fires or another track is
 /// reached. Where S holds no point with ρ of at least the stop threshold, the toe is looked
 /// for on a virtual profile across the search direction ([`Profile::toe`]; the curb rises
 /// on the side `up` of the direction: +1 left, −1 right) before the step counts as a gap.
 /// `prior_steps` counts the vertices the track already has behind `start` (the other
 /// direction's), which count towards [`CUT_MIN_TRACK_STEPS`].
-/// Returns the vertices picked (not including `start`) and the join, if any.
+/// Returns the vertices picked (not including `start`), the join, if any, and the run of
+/// flush crossings' toes the track ends in, held apart from the vertices ([`FlushTail`]).
 #[allow(clippy::too_many_arguments)]
 fn track_one_way(
     input: &BendInput,
@@ -527,7 +531,7 @@ fn track_one_way(
     up: f64,
     next_virtual: &mut u32,
     params: &BendParams,
-) -> (Vec<(u32, [f64; 3])>, Option<Join>, Vec<(u32, [f64; 3])>) {
+) -> (Vertices, Option<Join>, Vertices) {
     let s = start as usize;
     let mut cur = [input.x[s], input.y[s], input.z[s]];
     // The side the curb rises on; a track brought down from the top edge takes the side
