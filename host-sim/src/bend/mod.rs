@@ -16,6 +16,7 @@ pub mod bridge;
 pub mod claims;
 pub mod climb;
 pub mod face;
+pub mod flush;
 pub mod grid;
 pub mod leg;
 pub mod params;
@@ -176,7 +177,7 @@ pub fn extract_edges_on_grid(
             .then(a.interval.cmp(&b.interval))
             .then(a.point.cmp(&b.point))
     });
-    let mut tracks = track::track_edges(&input, grid, &seeds, params);
+    let (mut tracks, tails) = track::track_edges_with_tails(&input, grid, &seeds, params);
     shadow::place_shadowed_toes(&input, grid, &mut tracks, params);
     let tracks = postfilter::remove_short(&input, tracks, params);
     let tracks = postfilter::remove_under_objects(&input, grid, tracks, params);
@@ -190,10 +191,13 @@ pub fn extract_edges_on_grid(
     let next_id = tracks
         .iter()
         .flat_map(|t| t.points.iter().copied())
+        .chain(tails.iter().flat_map(|t| t.verts.iter().map(|v| v.0)))
         .max()
         .map_or(0, |m| m.saturating_add(1))
         .max(input.x.len() as u32);
     let tracks = bridge::bridge_tracks(&input, grid, tracks, next_id, params);
+    // Runs of flush toes go back on the ends no bridge continues.
+    let tracks = flush::attach_tails(tracks, tails);
     postfilter::to_edge_lines_with_steps(&input, grid, route, &tracks, params)
 }
 

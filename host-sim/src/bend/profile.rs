@@ -255,7 +255,7 @@ std::thread_local! {
 
 impl Profile<'_> {
     /// The profile's points as (across, z, along), sorted by `across`, then height.
-    fn gather(&self) -> Vec<(f64, f64, f64)> {
+    pub(super) fn gather(&self) -> Vec<(f64, f64, f64)> {
         let input = self.input;
         SCRATCH.with_borrow_mut(|s| {
             s.prof.clear();
@@ -365,12 +365,12 @@ fn sort_across(
 
 /// Prefix sums of 1, c, c², z, c·z, z² over a sorted profile (heights relative to the
 /// first point, for precision): a least-squares line over any run of its points in O(1).
-struct Sums {
-    acc: Vec<[f64; 6]>,
+pub(super) struct Sums {
+    pub(super) acc: Vec<[f64; 6]>,
 }
 
 impl Sums {
-    fn new(prof: &[(f64, f64, f64)]) -> Self {
+    pub(super) fn new(prof: &[(f64, f64, f64)]) -> Self {
         let z0 = prof.first().map_or(0.0, |p| p.1);
         let mut acc = Vec::with_capacity(prof.len() + 1);
         let mut run = [0.0f64; 6];

@@ -37,6 +37,19 @@ pub struct Track {
     pub side: Side,
 }
 
+/// A run of flush crossings' toes ([`Profile::flush_toe`]) that a track ended in, held
+/// apart from it until the bridges are built: the vertex of the track it follows on from
+/// (`anchor`, the track's last toe with a rise) and its vertices, outward from there.
+///
+/// A flush crossing's toes place its curb line to a few centimetres, which is worse than a
+/// bridge's arc between the curbs on either side; where no bridge continues the track, they
+/// are the only line across the cut.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FlushTail {
+    pub anchor: u32,
+    pub verts: Vec<(u32, [f64; 3])>,
+}
+
 impl Track {
     /// A track of measured points only.
     pub fn measured(input: &BendInput, points: Vec<u32>, side: Side) -> Self {
@@ -58,6 +71,20 @@ pub fn track_edges(
     seeds: &[Seed],
     params: &BendParams,
 ) -> Vec<Track> {
+    let (tracks, tails) = track_edges_with_tails(input, grid, seeds, params);
+    super::flush::attach_tails(tracks, tails)
+}
+
+/// [`track_edges`] with the runs of flush crossings' toes that tracks end in held apart
+/// ([`FlushTail`]), to be put back by [`super::flush::attach_tails`] where no bridge
+/// continues the track.
+pub fn track_edges_with_tails(
+    input: &BendInput,
+    grid: &PointGrid,
+    seeds: &[Seed],
+    params: &BendParams,
+) -> (Vec<Track>, Vec<FlushTail>) {
+    let mut tails: Vec<FlushTail> = Vec::new();
     let mut claims = Claims::new(params.join_distance_m);
     // Tracks by id; merged tracks leave `None` behind and point to their root.
     let mut tracks: Vec<Option<Track>> = Vec::new();
@@ -105,21 +132,46 @@ pub fn track_edges(
                 params,
             )
         };
-        let (mut fwd, mut fwd_join) = one_way(dir, up_fwd, 0);
-        let (bwd, bwd_join) = one_way([-dir[0], -dir[1], 0.0], -up_fwd, fwd.len());
+        let (mut fwd, mut fwd_join, mut fwd_tail) = one_way(dir, up_fwd, 0);
+        let (bwd, bwd_join, mut bwd_tail) = one_way([-dir[0], -dir[1], 0.0], -up_fwd, fwd.len());
         // A seed just before a curb cut: forward, the track had too little curb behind it
         // to follow the cut; with the curb tracked backwards it has.
         if fwd_join.is_none() && fwd.len() < CUT_MIN_TRACK_STEPS && bwd.len() >= CUT_MIN_TRACK_STEPS
         {
-            (fwd, fwd_join) = one_way(dir, up_fwd, bwd.len());
+            (fwd, fwd_join, fwd_tail) = one_way(dir, up_fwd, bwd.len());
         }
         let seed_xyz = [input.x[s], input.y[s], input.z[s]];
         let mut verts: Vec<(u32, [f64; 3])> = bwd.iter().rev().copied().collect();
         verts.push((seed.point, seed_xyz));
         verts.extend_from_slice(&fwd);
+        // A track shorter than a bridge's tangent without its runs of flush toes (one that
+        // starts on the cut) keeps them: its tangent is theirs.
+        let length: f64 = verts
+            .windows(2)
+            .map(|w| (w[1].1[0] - w[0].1[0]).hypot(w[1].1[1] - w[0].1[1]))
+            .sum();
+        if length < FLUSH_HOLD_MIN_M {
+            verts.splice(0..0, bwd_tail.iter().rev().copied());
+            verts.append(&mut fwd_tail);
+            bwd_tail.clear();
+        }
         let points: Vec<u32> = verts.iter().map(|v| v.0).collect();
         let xyz: Vec<[f64; 3]> = verts.iter().map(|v| v.1).collect();
         claims.add_track(&points, &xyz, id);
+        // The held runs claim their stretch as the track does.
+        let seed_v = (seed.point, seed_xyz);
+        for (run, tail) in [(&fwd, fwd_tail), (&bwd, bwd_tail)] {
+            if !tail.is_empty() {
+                let anchor = *run.last().unwrap_or(&seed_v);
+                let (p, x): (Vec<u32>, Vec<[f64; 3]>) =
+                    std::iter::once(anchor).chain(tail.iter().copied()).unzip();
+                claims.add_track(&p, &x, id);
+                tails.push(FlushTail {
+                    anchor: anchor.0,
+                    verts: tail,
+                });
+            }
+        }
         tracks.push(Some(Track {
             points,
             xyz,
@@ -192,7 +244,7 @@ pub fn track_edges(
             parent[other] = me;
         }
     }
-    tracks.into_iter().flatten().collect()
+    (tracks.into_iter().flatten().collect(), tails)
 }
 
 /// Whether the ground rises on the left (+1) or the right (−1) of the horizontal direction
@@ -262,6 +314,10 @@ const MAX_TOE_DZ_M: f64 = 0.04;
 /// ([`Profile::cut_toe`]): 1.5 m of curb, so that the break of slope is only ever followed
 /// along a line already tracked.
 const CUT_MIN_TRACK_STEPS: usize = 10;
+
+/// Shortest track, without the runs of flush toes it ends in, whose runs are held apart
+/// until the bridges are built ([`FlushTail`]), metres: the bridge's tangent span.
+const FLUSH_HOLD_MIN_M: f64 = 2.0;
 
 /// Shortest run on curb-cut toes kept at the end of a track, metres (see
 /// [`track_one_way`]): a third of the shortest cut.
@@ -453,13 +509,17 @@ fn unit3(v: [f64; 3]) -> Option<[f64; 3]> {
     (l > 1e-9).then(|| [v[0] / l, v[1] / l, v[2] / l])
 }
 
+/// A track's vertices as (id, position) pairs.
+type Vertices = Vec<(u32, [f64; 3])>;
+
 /// Tracks from `start` along `dir0` until the stop rule of §2.7 fires or another track is
 /// reached. Where S holds no point with ρ of at least the stop threshold, the toe is looked
 /// for on a virtual profile across the search direction ([`Profile::toe`]; the curb rises
 /// on the side `up` of the direction: +1 left, −1 right) before the step counts as a gap.
 /// `prior_steps` counts the vertices the track already has behind `start` (the other
 /// direction's), which count towards [`CUT_MIN_TRACK_STEPS`].
-/// Returns the vertices picked (not including `start`) and the join, if any.
+/// Returns the vertices picked (not including `start`), the join, if any, and the run of
+/// flush crossings' toes the track ends in, held apart from the vertices ([`FlushTail`]).
 #[allow(clippy::too_many_arguments)]
 fn track_one_way(
     input: &BendInput,
@@ -472,14 +532,14 @@ fn track_one_way(
     up: f64,
     next_virtual: &mut u32,
     params: &BendParams,
-) -> (Vec<(u32, [f64; 3])>, Option<Join>) {
+) -> (Vertices, Option<Join>, Vertices) {
     let s = start as usize;
     let mut cur = [input.x[s], input.y[s], input.z[s]];
     // The side the curb rises on; a track brought down from the top edge takes the side
     // the ground shows there.
     let mut up = up;
     let Some(mut v) = unit3(dir0) else {
-        return (Vec::new(), None);
+        return (Vec::new(), None, Vec::new());
     };
     let mut prev_u = v;
     let mut picked: Vec<(u32, [f64; 3])> = Vec::new();
@@ -500,8 +560,12 @@ fn track_one_way(
     // metres, and the index in `picked` where that stretch starts.
     let mut weak_run_m = 0.0f64;
     let mut weak_from: Option<usize> = None;
+    // Flush crossings' toes ([`Profile::flush_toe`]) among the vertices picked.
+    let mut flush_ids: std::collections::HashSet<u32> = std::collections::HashSet::new();
 
     for _ in 0..params.max_steps {
+        // Whether this step's toe is a flush crossing's.
+        let mut flush_step = false;
         // Horizontal direction of the curb line this step's toe is found along, if any (a
         // cut's toe, see [`line_ahead`], or a toe below the top edge): it replaces the
         // direction of the step to that toe.
@@ -605,12 +669,15 @@ fn track_one_way(
                         // not one step along v: v follows the scatter of the toes before.
                         let line = line_ahead(&picked, cur, along, d_s);
                         let (cc, ca) = line.map_or((c, along), |(p, a)| ([p[0], p[1], cur[2]], a));
-                        let t = Profile {
+                        let on_line = Profile {
                             centre: cc,
                             along: ca,
                             ..long
-                        }
-                        .cut_toe();
+                        };
+                        let t = on_line.cut_toe().or_else(|| {
+                            flush_step = true;
+                            on_line.flush_toe()
+                        });
                         if t.is_some() {
                             cut_run_m += d_s;
                             cut_from.get_or_insert(picked.len());
@@ -631,6 +698,7 @@ fn track_one_way(
             let found = match found.filter(ahead) {
                 Some(t) => Some(t),
                 None if params.profile_fallback && *next_virtual < u32::MAX => {
+                    flush_step = false;
                     let c = [pred[0], pred[1], cur[2]];
                     climbed_toe(input, grid, c, along, params.profile_half_length_m, params)
                         .filter(|(t, _)| ahead(t))
@@ -801,7 +869,7 @@ fn track_one_way(
         };
         let (n, p) = next;
         if let Some(j) = claims.near(n, p[0], p[1], own) {
-            return (picked, Some(j));
+            return (picked, Some(j), Vec::new());
         }
         let start_xyz = [input.x[s], input.y[s], input.z[s]];
         let base = picked
@@ -841,6 +909,9 @@ fn track_one_way(
         }
         v = v_new;
         prev_u = u;
+        if flush_step {
+            flush_ids.insert(n);
+        }
         picked.push((n, p));
         own_pts.insert(n);
         cur = p;
@@ -856,7 +927,14 @@ fn track_one_way(
     if let Some(k) = weak_from {
         picked.truncate(k);
     }
-    (picked, None)
+    // A run of flush crossings' toes the track ends in is held apart (see
+    // [`super::flush::attach_tails`]): the track ends at its last toe with a rise.
+    let k = picked
+        .iter()
+        .rposition(|v| !flush_ids.contains(&v.0))
+        .map_or(0, |i| i + 1);
+    let tail = picked.split_off(k);
+    (picked, None, tail)
 }
 
 #[cfg(test)]
