@@ -309,7 +309,7 @@ fn parabola(xy: &[(f64, f64)]) -> Option<[f64; 3]> {
             + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
     };
     let det = det3(&mat);
-    if !(det.abs() > 1e-12 * s[0].powi(3)) {
+    if det.is_nan() || det.abs() <= 1e-12 * s[0].powi(3) {
         return None;
     }
     // Cramer's rule, column by column.
