@@ -241,6 +241,179 @@ fn on_arc(a: [f64; 3], b: [f64; 3], alpha: f64, s: f64) -> [f64; 3] {
     ]
 }
 
+/// Length of each track beside a bridge over which the curb's line is fitted, metres:
+/// three times [`TANGENT_SPAN_M`], so that the toe's scatter and its drift over the last
+/// metres (where a cut lowers the curb) weigh little against the curb's own line.
+const CURVE_FIT_SPAN_M: f64 = 6.0;
+
+/// Largest turn from the chord at either end, from the ends' tangents, for which a bridge
+/// is laid by [`curb_line_fit`], degrees: a curb that continues across the bridge with a
+/// bend of a large radius; a sharper turn (an intersection's corner) keeps the tangents'
+/// arc.
+const CURVE_FIT_MAX_TURN_DEG: f64 = 4.0;
+
+/// Least distance from the fitted line of a track's end vertex that drifted off it,
+/// metres: over the toe's scatter along most tracks.
+const DRIFT_MIN_M: f64 = 0.025;
+
+/// Longest drift at a track's end that is left out of a bridge, metres: a cut's
+/// transition and the first metre of its lowered part.
+const DRIFT_MAX_M: f64 = 2.0;
+
+/// Largest difference between the curvatures of the two tracks' own fits for one fit
+/// over both to be used, 1/m: a 50 m radius against a straight curb; over the noise of
+/// a curvature fitted to a few metres of scattered toe.
+const CURVE_FIT_MAX_BEND_DIFF: f64 = 0.02;
+
+/// Largest root-mean-square distance of the vertices left from the fitted line for the
+/// fit to be used, metres: over the toe's scatter along a track.
+const CURVE_FIT_MAX_RMS_M: f64 = 0.02;
+
+/// The vertices of `t` from the end `e` (past its dropped hook) inwards over
+/// [`CURVE_FIT_SPAN_M`] of track, each with its length of track from the end.
+fn fit_vertices(t: &Track, e: &End) -> Vec<([f64; 3], f64)> {
+    let n = t.xyz.len();
+    let at = |k: usize| if e.last { t.xyz[n - 1 - k] } else { t.xyz[k] };
+    let mut out: Vec<([f64; 3], f64)> = Vec::new();
+    for k in e.drop..n {
+        let q = at(k);
+        let along = out
+            .last()
+            .map_or(0.0, |&(p, l)| l + (q[0] - p[0]).hypot(q[1] - p[1]));
+        if along > CURVE_FIT_SPAN_M {
+            break;
+        }
+        out.push((q, along));
+    }
+    out
+}
+
+/// Least-squares parabola y = p + q·x + c·x² through `xy`; `None` when singular.
+fn parabola(xy: &[(f64, f64)]) -> Option<[f64; 3]> {
+    let mut s = [0.0f64; 5];
+    let mut t = [0.0f64; 3];
+    for &(x, y) in xy {
+        let mut xk = 1.0;
+        for (k, sk) in s.iter_mut().enumerate() {
+            *sk += xk;
+            if k < 3 {
+                t[k] += xk * y;
+            }
+            xk *= x;
+        }
+    }
+    let mat = [[s[0], s[1], s[2]], [s[1], s[2], s[3]], [s[2], s[3], s[4]]];
+    let det3 = |m: &[[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let det = det3(&mat);
+    if det.is_nan() || det.abs() <= 1e-12 * s[0].powi(3) {
+        return None;
+    }
+    // Cramer's rule, column by column.
+    let solve = |col: usize| {
+        let mut mk = mat;
+        for (row, tk) in mk.iter_mut().zip(t) {
+            row[col] = tk;
+        }
+        det3(&mk) / det
+    };
+    Some([solve(0), solve(1), solve(2)])
+}
+
+/// The bridge between the tracks of ends `a` and `b` laid on the curb's line as both
+/// tracks give it: a parabola across the chord fitted to [`CURVE_FIT_SPAN_M`] of each
+/// track; the vertices at either end that drifted off it (at least [`DRIFT_MIN_M`], over
+/// at most [`DRIFT_MAX_M`] of track) are left out and the fit made again without them.
+/// Returns the new ends, the chord between them and the turn from the chord at the first
+/// (left positive, as [`fit`] gives it) of the arc with the parabola's curvature. `None`
+/// when either track keeps fewer than three vertices, the fit is singular or the vertices
+/// left lie farther than [`CURVE_FIT_MAX_RMS_M`] from it (the curb bends in another way
+/// than one arc).
+///
+/// Where a cut lowers the curb the toe a track follows fades and the kernel's peak drifts
+/// off the curb's line over the last metres; tangents over those metres tilt, and an arc
+/// from the drifted ends with them runs off a straight curb by the drift and more.
+fn curb_line_fit(ta: &Track, a: &End, tb: &Track, b: &End) -> Option<(End, End, f64, f64)> {
+    let c = [b.xyz[0] - a.xyz[0], b.xyz[1] - a.xyz[1]];
+    let d = c[0].hypot(c[1]);
+    if d < 1e-6 {
+        return None;
+    }
+    let (u, nrm) = ([c[0] / d, c[1] / d], [-c[1] / d, c[0] / d]);
+    // Chord-centred coordinates, x scaled so the normal equations stay well conditioned.
+    let m = [a.xyz[0] + 0.5 * c[0], a.xyz[1] + 0.5 * c[1]];
+    let h = 0.5 * d + CURVE_FIT_SPAN_M;
+    let local = |q: [f64; 3]| {
+        let (dx, dy) = (q[0] - m[0], q[1] - m[1]);
+        ((dx * u[0] + dy * u[1]) / h, dx * nrm[0] + dy * nrm[1])
+    };
+    let (va, vb) = (fit_vertices(ta, a), fit_vertices(tb, b));
+    let (la, lb): (Vec<_>, Vec<_>) = (
+        va.iter().map(|&(q, _)| local(q)).collect(),
+        vb.iter().map(|&(q, _)| local(q)).collect(),
+    );
+    let (mut ka, mut kb) = (0usize, 0usize);
+    let mut coef = None;
+    for _ in 0..3 {
+        if va.len() < ka + 3 || vb.len() < kb + 3 {
+            return None;
+        }
+        let pts: Vec<(f64, f64)> = la[ka..].iter().chain(&lb[kb..]).copied().collect();
+        let f = parabola(&pts)?;
+        let off = |&(x, y): &(f64, f64)| (y - f[0] - f[1] * x - f[2] * x * x).abs();
+        let drift = |v: &[([f64; 3], f64)], l: &[(f64, f64)]| {
+            v.iter()
+                .zip(l)
+                .take_while(|((_, along), xy)| *along <= DRIFT_MAX_M && off(xy) >= DRIFT_MIN_M)
+                .count()
+        };
+        let (na, nb) = (drift(&va, &la), drift(&vb, &lb));
+        coef = Some((f, pts));
+        if (na, nb) == (ka, kb) {
+            break;
+        }
+        (ka, kb) = (na, nb);
+    }
+    let (f, pts) = coef?;
+    if va.len() < ka + 3 || vb.len() < kb + 3 {
+        return None;
+    }
+    // Both tracks bend alike: a curb that bends on one side of the bridge and runs
+    // straight on the other (a corner's arc meeting the straight curb at a cut) is not one
+    // arc.
+    let (fa, fb) = (parabola(&la[ka..])?, parabola(&lb[kb..])?);
+    if 2.0 * (fa[2] - fb[2]).abs() / (h * h) > CURVE_FIT_MAX_BEND_DIFF {
+        return None;
+    }
+    let rss: f64 = pts
+        .iter()
+        .map(|&(x, y)| (y - f[0] - f[1] * x - f[2] * x * x).powi(2))
+        .sum();
+    if (rss / pts.len() as f64).sqrt() > CURVE_FIT_MAX_RMS_M {
+        return None;
+    }
+    let na = End {
+        xyz: va[ka].0,
+        drop: a.drop + ka,
+        inner: None,
+        ..*a
+    };
+    let nb = End {
+        xyz: vb[kb].0,
+        drop: b.drop + kb,
+        inner: None,
+        ..*b
+    };
+    let dn = (nb.xyz[0] - na.xyz[0]).hypot(nb.xyz[1] - na.xyz[1]);
+    // Curvature in metres: y'' = 2c / h². The arc with it bulges left (its tangent at the
+    // first end turns left) where it is negative.
+    let curvature = 2.0 * f[2] / (h * h);
+    Some((na, nb, dn, -(0.5 * curvature * dn).clamp(-1.0, 1.0).asin()))
+}
+
 /// Spacing of the ground checks along a bridge, metres.
 const CHECK_STEP_M: f64 = 0.5;
 
@@ -319,6 +492,12 @@ pub fn bridge_tracks(
                 let (ua, ub, chord, bulge) = match fit(&ua, &ub, params) {
                     Some((du, alpha_u)) => (ua, ub, du, alpha_u),
                     None => (*a, *b, d, alpha),
+                };
+                // A bridge along a gently bending curb is laid on the line of both tracks.
+                let (ua, ub, chord, bulge) = if bulge.abs() <= CURVE_FIT_MAX_TURN_DEG.to_radians() {
+                    curb_line_fit(ta, &ua, tb, &ub).unwrap_or((ua, ub, chord, bulge))
+                } else {
+                    (ua, ub, chord, bulge)
                 };
                 // No other track may cross the bridge's chord.
                 let (p, q) = ([a.xyz[0], a.xyz[1]], [b.xyz[0], b.xyz[1]]);
@@ -494,6 +673,53 @@ mod tests {
         // The bridge continues the curb's line, and the hooks are left out.
         assert!(bridged.iter().all(|(_, q)| (q[1] - 5.0).abs() < 1e-6));
         assert!(t.xyz.iter().all(|q| q[1] > 4.995), "{:?}", t.xyz);
+    }
+
+    #[test]
+    fn ends_that_drift_off_a_straight_curb_are_bridged_on_its_line() {
+        let g = ground(|_, _| false);
+        // A straight curb along y = 5 with 8 m missing (a flush cut); over the last 1.5 m
+        // before the gap each track drifts 6 cm away from the road, with a vertex's
+        // scatter of ±1 cm, as the kernel's peak does where the curb lowers slowly.
+        let scatter = |x: f64| 0.01 * (7.3 * x).sin();
+        let drift = |d: f64| 0.06 * (1.0 - d / 1.5).max(0.0);
+        let before = line(0.0, 10.0, |x| 5.0 + scatter(x) + drift(10.0 - x), 0);
+        let after = line(18.0, 30.0, |x| 5.0 + scatter(x) + drift(x - 18.0), 100);
+        let out = bridge(&g, vec![before, after]);
+        assert_eq!(out.len(), 1);
+        let t = &out[0];
+        let bridged: Vec<_> = t
+            .points
+            .iter()
+            .zip(&t.xyz)
+            .filter(|(&id, _)| id >= 1_000_000)
+            .collect();
+        assert!(bridged.len() > 50);
+        // The bridge runs from vertices within the fit's drift limit of the curb's line,
+        // and the farthest drifted vertices are left out.
+        let worst = bridged
+            .iter()
+            .map(|(_, q)| (q[1] - 5.0).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 0.04, "{worst}");
+        assert!(t.xyz.iter().all(|q| q[1] < 5.045), "{:?}", t.xyz);
+    }
+
+    #[test]
+    fn a_gentle_bend_is_bridged_on_the_bend_of_both_tracks() {
+        let g = ground(|_, _| false);
+        // A 150 m radius arc about (0, 150): its tangents over 2 m turn by under 4°.
+        let r = 150.0f64;
+        let arc = |x: f64| r - (r * r - x * x).sqrt();
+        let tracks = vec![line(-12.0, -4.0, arc, 0), line(4.0, 12.0, arc, 100)];
+        let out = bridge(&g, tracks);
+        assert_eq!(out.len(), 1);
+        let worst = out[0]
+            .xyz
+            .iter()
+            .map(|q| (q[0].hypot(q[1] - r) - r).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 0.005, "{worst}");
     }
 
     #[test]
