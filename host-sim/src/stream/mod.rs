@@ -796,6 +796,10 @@ mod stage_tests {
             b.search_radius_m
         );
         assert_eq!(b.stop_rho_deg, 22.5);
+        assert!(
+            cfg.bend.leg_toes && !b.leg_toes,
+            "far-leg toes on profilers only"
+        );
         let view = b.end_view.expect("rings see past the points' ends");
         assert_eq!(view.reach_m, f64::from(cfg.rings.max_reach_m));
         assert_eq!(view.max_azimuth_deg, f64::from(cfg.rings.max_azimuth_deg));
@@ -803,6 +807,7 @@ mod stage_tests {
         let back = crate::bend::BendParams {
             search_radius_m: cfg.bend.search_radius_m,
             stop_rho_deg: cfg.bend.stop_rho_deg,
+            leg_toes: cfg.bend.leg_toes,
             end_view: None,
             ..b
         };
