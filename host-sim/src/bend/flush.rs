@@ -15,7 +15,6 @@
 use std::cmp::Ordering;
 
 use super::profile::{Profile, ProfileToe, Sums};
-use super::track::{FlushTail, Track};
 
 /// Farthest the hinge may lie across the profile from its centre, metres: a cut keeps the
 /// line of the curb it interrupts, so the toe stays near where the track predicts it.
@@ -228,29 +227,6 @@ impl Profile<'_> {
     }
 }
 
-/// Puts each held run of flush toes ([`FlushTail`]) back on the track that still ends at
-/// its anchor, outward from that end; a run whose anchor is no longer an end (a bridge or a
-/// join continues the track there, or the track was dropped) is dropped.
-pub fn attach_tails(mut tracks: Vec<Track>, tails: Vec<FlushTail>) -> Vec<Track> {
-    for tail in tails {
-        let Some(t) = tracks.iter_mut().find(|t| {
-            t.points.len() >= 2
-                && (t.points.last() == Some(&tail.anchor) || t.points.first() == Some(&tail.anchor))
-        }) else {
-            continue;
-        };
-        if t.points.last() == Some(&tail.anchor) {
-            t.points.extend(tail.verts.iter().map(|v| v.0));
-            t.xyz.extend(tail.verts.iter().map(|v| v.1));
-        } else {
-            let (p, x): (Vec<u32>, Vec<[f64; 3]>) = tail.verts.iter().rev().copied().unzip();
-            t.points.splice(0..0, p);
-            t.xyz.splice(0..0, x);
-        }
-    }
-    tracks
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -352,27 +328,5 @@ mod tests {
                 assert!((t.step_m - lip).abs() < 0.004, "lip {lip}: {t:?}");
             }
         }
-    }
-
-    #[test]
-    fn a_held_run_of_flush_toes_goes_back_only_on_an_end() {
-        use crate::model::Side;
-        let track = |ids: &[u32]| Track {
-            points: ids.to_vec(),
-            xyz: ids.iter().map(|&i| [f64::from(i), 0.0, 0.0]).collect(),
-            side: Side::Right,
-        };
-        let tail = |anchor: u32, ids: &[u32]| FlushTail {
-            anchor,
-            verts: ids.iter().map(|&i| (i, [f64::from(i), 0.0, 0.0])).collect(),
-        };
-        let out = attach_tails(
-            vec![track(&[3, 4, 5]), track(&[10, 11, 12])],
-            vec![tail(5, &[6, 7]), tail(10, &[9, 8]), tail(4, &[20])],
-        );
-        // Outward from the last vertex, outward from the first; not from the middle.
-        assert_eq!(out[0].points, [3, 4, 5, 6, 7]);
-        assert_eq!(out[1].points, [8, 9, 10, 11, 12]);
-        assert_eq!(out[1].xyz[0], [8.0, 0.0, 0.0]);
     }
 }

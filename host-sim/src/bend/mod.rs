@@ -197,7 +197,7 @@ pub fn extract_edges_on_grid(
         .max(input.x.len() as u32);
     let tracks = bridge::bridge_tracks(&input, grid, tracks, next_id, params);
     // Runs of flush toes go back on the ends no bridge continues.
-    let tracks = flush::attach_tails(tracks, tails);
+    let tracks = track::attach_tails(tracks, tails);
     postfilter::to_edge_lines_with_steps(&input, grid, route, &tracks, params)
 }
 

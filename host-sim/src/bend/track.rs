@@ -72,11 +72,11 @@ pub fn track_edges(
     params: &BendParams,
 ) -> Vec<Track> {
     let (tracks, tails) = track_edges_with_tails(input, grid, seeds, params);
-    super::flush::attach_tails(tracks, tails)
+    attach_tails(tracks, tails)
 }
 
 /// [`track_edges`] with the runs of flush crossings' toes that tracks end in held apart
-/// ([`FlushTail`]), to be put back by [`super::flush::attach_tails`] where no bridge
+/// ([`FlushTail`]), to be put back by [`attach_tails`] where no bridge
 /// continues the track.
 pub fn track_edges_with_tails(
     input: &BendInput,
@@ -928,13 +928,36 @@ fn track_one_way(
         picked.truncate(k);
     }
     // A run of flush crossings' toes the track ends in is held apart (see
-    // [`super::flush::attach_tails`]): the track ends at its last toe with a rise.
+    // [`attach_tails`]): the track ends at its last toe with a rise.
     let k = picked
         .iter()
         .rposition(|v| !flush_ids.contains(&v.0))
         .map_or(0, |i| i + 1);
     let tail = picked.split_off(k);
     (picked, None, tail)
+}
+
+/// Puts each held run of flush toes ([`FlushTail`]) back on the track that still ends at
+/// its anchor, outward from that end; a run whose anchor is no longer an end (a bridge or a
+/// join continues the track there, or the track was dropped) is dropped.
+pub fn attach_tails(mut tracks: Vec<Track>, tails: Vec<FlushTail>) -> Vec<Track> {
+    for tail in tails {
+        let Some(t) = tracks.iter_mut().find(|t| {
+            t.points.len() >= 2
+                && (t.points.last() == Some(&tail.anchor) || t.points.first() == Some(&tail.anchor))
+        }) else {
+            continue;
+        };
+        if t.points.last() == Some(&tail.anchor) {
+            t.points.extend(tail.verts.iter().map(|v| v.0));
+            t.xyz.extend(tail.verts.iter().map(|v| v.1));
+        } else {
+            let (p, x): (Vec<u32>, Vec<[f64; 3]>) = tail.verts.iter().rev().copied().unzip();
+            t.points.splice(0..0, p);
+            t.xyz.splice(0..0, x);
+        }
+    }
+    tracks
 }
 
 #[cfg(test)]
@@ -1368,5 +1391,27 @@ mod tests {
         assert!((v[2] - MAX_CLIMB).abs() < 1e-12);
         assert!(((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt() - 1.0).abs() < 1e-12);
         assert_eq!(clamp_climb([1.0, 0.0, 0.0]), [1.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn a_held_run_of_flush_toes_goes_back_only_on_an_end() {
+        use crate::model::Side;
+        let track = |ids: &[u32]| Track {
+            points: ids.to_vec(),
+            xyz: ids.iter().map(|&i| [f64::from(i), 0.0, 0.0]).collect(),
+            side: Side::Right,
+        };
+        let tail = |anchor: u32, ids: &[u32]| FlushTail {
+            anchor,
+            verts: ids.iter().map(|&i| (i, [f64::from(i), 0.0, 0.0])).collect(),
+        };
+        let out = attach_tails(
+            vec![track(&[3, 4, 5]), track(&[10, 11, 12])],
+            vec![tail(5, &[6, 7]), tail(10, &[9, 8]), tail(4, &[20])],
+        );
+        // Outward from the last vertex, outward from the first; not from the middle.
+        assert_eq!(out[0].points, [3, 4, 5, 6, 7]);
+        assert_eq!(out[1].points, [8, 9, 10, 11, 12]);
+        assert_eq!(out[1].xyz[0], [8.0, 0.0, 0.0]);
     }
 }
