@@ -705,37 +705,31 @@ mod tests {
         assert!(t.xyz.iter().all(|q| q[1] < 5.045), "{:?}", t.xyz);
     }
 
-    #[test]
-    fn a_gentle_bend_is_bridged_on_the_bend_of_both_tracks() {
+    /// Two tracks on an arc of radius `r` about (0, `r`), 8 m each with 8 m between them,
+    /// bridged: the bridge's largest distance from the arc.
+    fn arc_bridged_off_by(r: f64) -> f64 {
         let g = ground(|_, _| false);
-        // A 150 m radius arc about (0, 150): its tangents over 2 m turn by under 4°.
-        let r = 150.0f64;
         let arc = |x: f64| r - (r * r - x * x).sqrt();
         let tracks = vec![line(-12.0, -4.0, arc, 0), line(4.0, 12.0, arc, 100)];
         let out = bridge(&g, tracks);
         assert_eq!(out.len(), 1);
-        let worst = out[0]
+        out[0]
             .xyz
             .iter()
             .map(|q| (q[0].hypot(q[1] - r) - r).abs())
-            .fold(0.0, f64::max);
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn a_gentle_bend_is_bridged_on_the_bend_of_both_tracks() {
+        // A 150 m radius: the tangents over 2 m turn by under 4°.
+        let worst = arc_bridged_off_by(150.0);
         assert!(worst < 0.005, "{worst}");
     }
 
     #[test]
     fn an_arc_is_bridged_on_the_arc() {
-        let g = ground(|_, _| false);
-        // A 40 m radius arc about (0, 40): y = 40 − √(40² − x²).
-        let r = 40.0f64;
-        let arc = |x: f64| r - (r * r - x * x).sqrt();
-        let tracks = vec![line(-12.0, -4.0, arc, 0), line(4.0, 12.0, arc, 100)];
-        let out = bridge(&g, tracks);
-        assert_eq!(out.len(), 1);
-        let worst = out[0]
-            .xyz
-            .iter()
-            .map(|q| (q[0].hypot(q[1] - r) - r).abs())
-            .fold(0.0, f64::max);
+        let worst = arc_bridged_off_by(40.0);
         assert!(worst < 0.01, "{worst}");
     }
 
