@@ -175,15 +175,9 @@ pub fn face_toe(profile: &Profile) -> Option<ProfileToe> {
     }
     // The toe where the face's line crosses the middle of its strips along the profile.
     let a = edge.iter().map(|e| e.0).sum::<f64>() / edge.len() as f64;
-    let c = c0 + k * a;
-    let (centre, along) = (profile.centre, profile.along);
-    let nrm = [-along[1] * profile.up, along[0] * profile.up];
+    let [x, y] = profile.plan_at(a, c0 + k * a);
     Some(ProfileToe {
-        xyz: [
-            centre[0] + a * along[0] + c * nrm[0],
-            centre[1] + a * along[1] + c * nrm[1],
-            ra,
-        ],
+        xyz: [x, y, ra],
         step_m: step,
     })
 }

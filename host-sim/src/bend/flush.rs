@@ -156,7 +156,7 @@ impl Profile<'_> {
     /// [`Profile::cut_toe`], only for continuing a track along a curb line.
     pub fn flush_toe(&self) -> Option<ProfileToe> {
         const NEAR_M: f64 = 0.15;
-        let (params, centre, along) = (self.params, self.centre, self.along);
+        let params = self.params;
         let prof = self.gather();
         let m = prof.len();
         if m < 2 * FLUSH_MIN_SIDE {
@@ -215,13 +215,9 @@ impl Profile<'_> {
         }
         let near = prof.iter().filter(|p| (p.0 - t).abs() <= NEAR_M);
         let a = near.clone().map(|p| p.2).sum::<f64>() / near.count().max(1) as f64;
-        let n = [-along[1] * self.up, along[0] * self.up];
+        let [x, y] = self.plan_at(a, t);
         Some(ProfileToe {
-            xyz: [
-                centre[0] + a * along[0] + t * n[0],
-                centre[1] + a * along[1] + t * n[1],
-                prof[0].1 + h.a,
-            ],
+            xyz: [x, y, prof[0].1 + h.a],
             step_m: h.h,
         })
     }

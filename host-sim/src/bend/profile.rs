@@ -52,6 +52,15 @@ impl Profile<'_> {
         [-along[1] * up, along[0] * up]
     }
 
+    /// The point in plan `a` along the profile and `c` across it from its centre.
+    pub(super) fn plan_at(&self, a: f64, c: f64) -> [f64; 2] {
+        let (centre, along, n) = (self.centre, self.along, self.across());
+        [
+            centre[0] + a * along[0] + c * n[0],
+            centre[1] + a * along[1] + c * n[1],
+        ]
+    }
+
     /// [`Profile::toe`], else the toe on the profile twice as long: far from the scanner
     /// the points are sparse along the scanlines, and the short profile holds too few.
     pub fn toe_or_longer(&self) -> Option<ProfileToe> {
@@ -141,9 +150,8 @@ impl Profile<'_> {
 
     /// [`Profile::toe`]'s search, with the offsets it split the profile at.
     fn split(&self) -> Option<Split> {
-        let (params, centre, along) = (self.params, self.centre, self.along);
+        let params = self.params;
         let half_w = params.profile_half_width_m;
-        let n = self.across();
         const MIN_SIDE: usize = 4;
         let prof = self.gather();
         if prof.len() < 2 * MIN_SIDE {
@@ -224,11 +232,10 @@ impl Profile<'_> {
         let a = near.iter().sum::<f64>() / near.len().max(1) as f64;
         Some(Split {
             toe: ProfileToe {
-                xyz: [
-                    centre[0] + a * along[0] + toe * n[0],
-                    centre[1] + a * along[1] + toe * n[1],
-                    z,
-                ],
+                xyz: {
+                    let [x, y] = self.plan_at(a, toe);
+                    [x, y, z]
+                },
                 step_m: step,
             },
             at: toe,
@@ -441,10 +448,9 @@ impl Profile<'_> {
     /// along a curb line, where the prediction says where the toe is: on its own the break
     /// would be too weak a sign of a curb.
     pub fn cut_toe(&self) -> Option<ProfileToe> {
-        let (params, centre, along) = (self.params, self.centre, self.along);
+        let params = self.params;
         const MIN_SIDE: usize = 6;
         const NEAR_M: f64 = 0.15;
-        let n = self.across();
         let prof = self.gather();
         let m = prof.len();
         if m < 2 * MIN_SIDE {
@@ -499,11 +505,10 @@ impl Profile<'_> {
                 .count()
                 .max(1) as f64;
         Some(ProfileToe {
-            xyz: [
-                centre[0] + a * along[0] + toe * n[0],
-                centre[1] + a * along[1] + toe * n[1],
-                z0 + road(toe),
-            ],
+            xyz: {
+                let [x, y] = self.plan_at(a, toe);
+                [x, y, z0 + road(toe)]
+            },
             step_m: step.max(0.0),
         })
     }

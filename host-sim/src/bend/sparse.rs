@@ -172,8 +172,6 @@ pub fn sparse_toe(profile: &Profile, picked: &[(u32, [f64; 3])]) -> Option<Profi
         input,
         grid,
         params,
-        centre,
-        along,
         up,
         ..
     } = *profile;
@@ -223,14 +221,9 @@ pub fn sparse_toe(profile: &Profile, picked: &[(u32, [f64; 3])]) -> Option<Profi
     if (step - h).abs() > CURB_MATCH_SHARE * h {
         return None;
     }
-    let a = 0.5 * (last_low.a + first_high.a);
-    let n = [-along[1] * up, along[0] * up];
+    let [x, y] = profile.plan_at(0.5 * (last_low.a + first_high.a), toe);
     Some(ProfileToe {
-        xyz: [
-            centre[0] + a * along[0] + toe * n[0],
-            centre[1] + a * along[1] + toe * n[1],
-            road,
-        ],
+        xyz: [x, y, road],
         step_m: step,
     })
 }
