@@ -230,8 +230,13 @@ impl Columns {
             c += w.count_ones();
         }
         let kept = keep.sp.len();
-        let mut sp = std::mem::take(&mut keep.sp);
-        sp.extend_from_slice(&self.side_sp[n.min(side)..]);
+        // The store's stations in a buffer of their exact size: it is held while the
+        // next sections run, and the kept points' buffer grew by doubling.
+        let rest = &self.side_sp[n.min(side)..];
+        let mut sp = Vec::with_capacity(kept + rest.len());
+        sp.extend_from_slice(&keep.sp);
+        sp.extend_from_slice(rest);
+        keep.sp = Vec::new();
         let runs = keep.runs(n);
         compact(&mut self.x, &runs, n);
         compact(&mut self.y, &runs, n);
