@@ -554,19 +554,19 @@ impl<'a> SectionWindow<'a> {
         let m = self.margin_m();
         // The sections and their points `lo..hi` in the window as it is now: a section
         // runs while it starts on the route and its predecessor's eviction (of the points
-        // before its start less the margin) leaves points.
+        // before its start less the margin) leaves points. Only the first takes the side
+        // store; the others begin after it.
         let mut sections = Vec::new();
         let n = self.cols.len();
         let mut s0 = self.start;
         let mut from = 0;
         while s0 <= end && from < n {
             let s1 = s0 + l;
-            let lo = self.cols.t.partition_point(|&t| self.station(t) < s0 - m);
-            let hi = self
-                .cols
-                .t
-                .partition_point(|&t| self.station(t) < s1 + m + self.lag_m());
-            from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
+            let (mut lo, hi, next) = self.section_points(s0, s1);
+            if !sections.is_empty() {
+                lo = self.cols.t.partition_point(|&t| self.station(t) < s0 - m);
+            }
+            from = next;
             sections.push((s0, s1, lo, hi, from));
             s0 = s1;
         }
@@ -610,18 +610,30 @@ impl<'a> SectionWindow<'a> {
         out
     }
 
-    /// Runs the section `[start, s1)`, then evicts the points the next section does not
-    /// need.
-    fn run_section(&mut self, s1: f64) -> Vec<EdgeLine> {
+    /// The points `lo..hi` of the section `[s0, s1)` in the window as it is now, and where
+    /// the next section's points begin (`keep_from`: the grid's new slabs are cut there).
+    /// The section takes the whole side store: the store holds the points lying in its
+    /// window that were measured before it, and, while it waits, its own points thinned.
+    fn section_points(&self, s0: f64, s1: f64) -> (usize, usize, usize) {
         let m = self.margin_m();
-        let s0 = self.start;
-        let lo = self.cols.t.partition_point(|&t| self.station(t) < s0 - m);
+        let lo = if self.cols.side() > 0 {
+            0
+        } else {
+            self.cols.t.partition_point(|&t| self.station(t) < s0 - m)
+        };
         let hi = self
             .cols
             .t
             .partition_point(|&t| self.station(t) < s1 + m + self.lag_m());
-        // Where the next section's points begin: the grid's new slabs are cut there.
         let keep_from = self.cols.t.partition_point(|&t| self.station(t) < s1 - m);
+        (lo, hi, keep_from)
+    }
+
+    /// Runs the section `[start, s1)`, then evicts the points the next section does not
+    /// need.
+    fn run_section(&mut self, s1: f64) -> Vec<EdgeLine> {
+        let s0 = self.start;
+        let (lo, hi, keep_from) = self.section_points(s0, s1);
         let edges = if hi > lo {
             self.extract_range(lo, hi, keep_from.checked_sub(lo))
         } else {
@@ -629,7 +641,7 @@ impl<'a> SectionWindow<'a> {
         };
         let closed = self.close_section(edges, s0, s1);
         self.start = s1;
-        let keep = self.keep_low(keep_from, s1 - m, self.params.lead_max_m);
+        let keep = self.keep_low(keep_from, s1 - self.margin_m(), self.params.lead_max_m);
         self.cols.evict_keeping(keep_from, keep);
         closed
     }
@@ -695,8 +707,9 @@ fn extract_on(
     hi: usize,
     cut: Option<usize>,
 ) -> Vec<(EdgeLine, Vec<Option<f64>>)> {
-    if c.side() > 0 && lo == c.side() {
-        // The section begins where the side store ends: the store's points come first.
+    if c.side() > 0 && lo == 0 {
+        // The section takes the side store: the store's points come first.
+        let cut = cut.and_then(|k| k.checked_sub(c.side()));
         return extract_with_side(c, traj, route, bend, grid, hi, cut);
     }
     let cands = candidates_in(c, lo, hi);
@@ -940,8 +953,19 @@ mod tests {
 
     /// The points of `w` measured in `[t0, t1)` that lie (by x) in `[x0, x1)` at height `z`.
     fn held(w: &SectionWindow, t: (f64, f64), x: (f64, f64), z: f64) -> usize {
+        held_in(w, 0..w.cols.len(), t, x, z)
+    }
+
+    /// [`held`] among the window's points `range`.
+    fn held_in(
+        w: &SectionWindow,
+        range: std::ops::Range<usize>,
+        t: (f64, f64),
+        x: (f64, f64),
+        z: f64,
+    ) -> usize {
         let c = &w.cols;
-        (0..c.len())
+        range
             .filter(|&i| (t.0..t.1).contains(&c.t[i]) && (x.0..x.1).contains(&c.x[i]))
             .filter(|&i| c.z[i] == z)
             .count()
@@ -974,6 +998,14 @@ mod tests {
         // ...and the points that lie only in section 0 are released.
         assert_eq!(held(&w, (0.0, 5.0), (0.0, 49.0), 0.0), 0);
         assert_eq!(held(&w, (0.0, 5.0), (0.0, 200.0), 12.0), 0);
+        // The vehicle at 135 m: section 1 waits, its own points thinned into the store
+        // after those held for it, and it runs on both.
+        feed(&mut w, 81, 136);
+        assert_eq!(w.start, 60.0);
+        assert!(w.thinned >= 120.0);
+        let (lo, hi, _) = w.section_points(60.0, 120.0);
+        assert!(held_in(&w, lo..hi, (2.5, 5.0), (50.0, 75.0), 0.0) >= 900);
+        assert!(held_in(&w, lo..hi, (6.0, 11.0), (50.0, 120.0), 0.0) >= 900);
         // Without the side store and the wait, the window is cut by the vehicle's station.
         let params = WindowParams {
             lead_max_m: 0.0,
