@@ -110,6 +110,17 @@ impl Route {
         Some(self.arc_in(k, w))
     }
 
+    /// [`arc_at`](Self::arc_at) of a time `t` at or after sample `k`'s time and before
+    /// sample `k + 1`'s (at or after the last sample's when `k` is the last; before the
+    /// first sample's too when `k` is 0), for a caller that walks the samples itself.
+    pub fn arc_at_sample(&self, t: f64, k: usize) -> Option<f64> {
+        if self.t.len() < 2 || !t.is_finite() {
+            return self.arc_at(t);
+        }
+        let (j, w) = self.bracket_after(t, k + 1);
+        Some(self.arc_in(j, w))
+    }
+
     /// The arc length a fraction `w` of the way from sample `k` to the next.
     fn arc_in(&self, k: usize, w: f64) -> f64 {
         let next = (k + 1).min(self.s.len() - 1);
@@ -400,6 +411,41 @@ mod tests {
             assert_eq!(r.arc_at_from(t, &mut cursor).map(f64::to_bits), want, "{t}");
         }
         assert_eq!(r.arc_at_from(103.25, &mut cursor), Some(32.5));
+    }
+
+    #[test]
+    fn arc_at_a_walked_sample_is_the_arc_at_the_time() {
+        let r = east_route();
+        let single = Route::new(&Trajectory {
+            samples: vec![Pose {
+                t: 100.0,
+                x: 0.0,
+                y: 0.0,
+                z: 0.0,
+                roll_deg: 0.0,
+                pitch_deg: 0.0,
+                heading_deg: 0.0,
+            }],
+        });
+        // Before the first sample, on samples, between them, on and after the last, NaN.
+        for t in [
+            99.0,
+            100.0,
+            100.5,
+            101.0,
+            104.7,
+            109.99,
+            110.0,
+            111.0,
+            f64::NAN,
+        ] {
+            // The last sample at or before `t`, 0 when there is none.
+            let k = r.t.iter().rposition(|&u| u <= t).unwrap_or(0);
+            let want = r.arc_at(t).map(f64::to_bits);
+            assert_eq!(r.arc_at_sample(t, k).map(f64::to_bits), want, "{t}");
+            assert_eq!(single.arc_at_sample(t, 0), single.arc_at(t), "{t}");
+        }
+        assert_eq!(r.arc_at_sample(103.25, 3), Some(32.5));
     }
 
     #[test]

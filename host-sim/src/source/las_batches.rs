@@ -275,6 +275,35 @@ impl LasBatches {
     ) -> Result<(), LasError> {
         let rl = self.record_len;
         let raw = &self.pd.raw_bytes()[records.start * rl..records.end * rl];
+        let Some(gps_at) = self.gps_offset() else {
+            return Err(LasError::NoGpsTime {
+                path: self.path.clone(),
+                format: self.format,
+            });
+        };
+        if self.selection == Some(ScannerSelection::All) && rl >= gps_at + 8 {
+            // Every record kept: one pass over the records at the format's fixed offsets.
+            let from = out.len();
+            let tf = *self.pd.transforms();
+            let (seen, finite) = if self.extended {
+                append_all::<EXTENDED_HEAD>(raw, rl, &tf, out)
+            } else {
+                append_all::<LEGACY_HEAD>(raw, rl, &tf, out)
+            };
+            for c in 0..4 {
+                self.channels_seen[c] |= seen >> c & 1 == 1;
+            }
+            if let Err(e) = self.check_channels() {
+                out.keep_range(0..from);
+                return Err(e);
+            }
+            if let Some(r) = &self.ring {
+                for (k, rec) in out.channel[from..].iter_mut().zip(raw.chunks_exact(rl)) {
+                    *k = r.read(rec).unwrap_or(u8::MAX);
+                }
+            }
+            return self.check_keys_and_times(out, from, raw, finite);
+        }
         // Scanner channel: bits 4–5 of the flags byte at offset 15 (formats 6–10).
         let channel_of = |rec: &[u8]| if self.extended { (rec[15] >> 4) & 3 } else { 0 };
         if self.extended {
@@ -295,24 +324,8 @@ impl LasBatches {
                 ScannerSelection::PointSourceId(id)
             });
         }
-        if self.scanner.is_none() {
-            let seen: Vec<u8> = (0u8..4)
-                .filter(|&c| self.channels_seen[usize::from(c)])
-                .collect();
-            if seen.len() > 1 {
-                return Err(LasError::SeveralScanners {
-                    path: self.path.clone(),
-                    channels: seen,
-                });
-            }
-        }
+        self.check_channels()?;
         let sel = self.selection();
-        let Some(gps_at) = self.gps_offset() else {
-            return Err(LasError::NoGpsTime {
-                path: self.path.clone(),
-                format: self.format,
-            });
-        };
         // Field offsets of the point record (LAS 1.4 R15 tables 7 and 12): X, Y, Z at 0, 4,
         // 8, intensity at 12; scan angle, point source id and GPS time after the flags.
         let (sa_at, psid_at) = if self.extended { (18, 20) } else { (16, 18) };
@@ -376,25 +389,58 @@ impl LasBatches {
                 }
             }
         }
-        if let (Some(r), Some(k)) = (
-            &ring,
-            out.channel[from..].iter().position(|&c| c == u8::MAX),
-        ) {
-            return Err(LasError::NoPoints {
-                path: self.path.clone(),
-                what: format!(
-                    "point {}: extra-bytes dimension {:?} is not a ring number 0–254",
-                    self.done + k as u64,
-                    r.name
-                ),
-            });
+        self.check_keys_and_times(out, from, raw, false)
+    }
+
+    /// Without `--scanner`, a file with more than one scanner channel in the records seen
+    /// so far is refused.
+    fn check_channels(&self) -> Result<(), LasError> {
+        if self.scanner.is_none() {
+            let seen: Vec<u8> = (0u8..4)
+                .filter(|&c| self.channels_seen[usize::from(c)])
+                .collect();
+            if seen.len() > 1 {
+                return Err(LasError::SeveralScanners {
+                    path: self.path.clone(),
+                    channels: seen,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The points appended to `out` from index `from` on, decoded from `raw`: a ring that
+    /// is not 0–254 and a time that is not finite are refused, with the point's index in
+    /// the file. `finite`: every time is known to be finite.
+    fn check_keys_and_times(
+        &self,
+        out: &PointBatch,
+        from: usize,
+        raw: &[u8],
+        finite: bool,
+    ) -> Result<(), LasError> {
+        if let Some(r) = &self.ring {
+            if let Some(k) = out.channel[from..].iter().position(|&c| c == u8::MAX) {
+                return Err(LasError::NoPoints {
+                    path: self.path.clone(),
+                    what: format!(
+                        "point {}: extra-bytes dimension {:?} is not a ring number 0–254",
+                        self.done + k as u64,
+                        r.name
+                    ),
+                });
+            }
+        }
+        if finite {
+            return Ok(());
         }
         if let Some(k) = out.t[from..].iter().position(|t| !t.is_finite()) {
             // The index in the file: kept records before it, plus the skipped ones.
             let t = out.t[from + k];
+            let at = self.gps_offset().unwrap_or(0);
             let index = raw
-                .chunks_exact(rl)
-                .position(|r| f64_at(r, gps_at).to_bits() == t.to_bits())
+                .chunks_exact(self.record_len)
+                .position(|r| r[at..at + 8] == t.to_bits().to_le_bytes())
                 .unwrap_or(k) as u64;
             return Err(LasError::BadTime {
                 path: self.path.clone(),
@@ -457,4 +503,69 @@ impl LasBatches {
         r.take_slab(&mut b, 0..1)?;
         Ok(b.t.first().copied())
     }
+}
+
+/// Bytes of a legacy record up to the end of its GPS time (formats 1, 3, 4, 5: X, Y, Z,
+/// intensity, flags, class, scan angle rank at 16, user data, point source id, GPS time at
+/// 20).
+const LEGACY_HEAD: usize = 28;
+
+/// Bytes of a format 6–10 record up to the end of its GPS time (flags with the scanner
+/// channel at 15, scan angle at 18, GPS time at 22).
+const EXTENDED_HEAD: usize = 30;
+
+/// Appends every record of `raw` (records of `rl ≥ HEAD` bytes, the format's fields at
+/// the offsets of [`LEGACY_HEAD`] or [`EXTENDED_HEAD`]) to `out`, with the channel key
+/// the scanner channel (formats 6–10) or 0. Returns the scanner channels seen, bit `c` for
+/// channel `c`, and whether every time is finite.
+///
+/// The values are those of the per-field decoding in `take_slab` (the `las` crate's
+/// transform, its scan angle units); the columns are written in one pass over the records.
+fn append_all<const HEAD: usize>(
+    raw: &[u8],
+    rl: usize,
+    tf: &las::Vector<las::Transform>,
+    out: &mut PointBatch,
+) -> (u8, bool) {
+    let extended = HEAD == EXTENDED_HEAD;
+    let n = raw.len() / rl;
+    let from = out.len();
+    out.x.resize(from + n, 0.0);
+    out.y.resize(from + n, 0.0);
+    out.z.resize(from + n, 0.0);
+    out.t.resize(from + n, 0.0);
+    out.intensity.resize(from + n, 0);
+    out.scan_angle_deg.resize(from + n, 0.0);
+    out.channel.resize(from + n, 0);
+    let cols = out.x[from..]
+        .iter_mut()
+        .zip(&mut out.y[from..])
+        .zip(&mut out.z[from..])
+        .zip(&mut out.t[from..])
+        .zip(&mut out.intensity[from..])
+        .zip(&mut out.scan_angle_deg[from..])
+        .zip(&mut out.channel[from..]);
+    let (mut seen, mut finite) = (0u8, true);
+    for (((((((x, y), z), t), i), a), c), rec) in cols.zip(raw.chunks_exact(rl)) {
+        let Some(r) = rec.first_chunk::<HEAD>() else {
+            continue;
+        };
+        let i32_at = |k: usize| i32::from_le_bytes([r[k], r[k + 1], r[k + 2], r[k + 3]]);
+        *x = tf.x.direct(i32_at(0));
+        *y = tf.y.direct(i32_at(4));
+        *z = tf.z.direct(i32_at(8));
+        let mut b = [0u8; 8];
+        b.copy_from_slice(&r[HEAD - 8..]);
+        *t = f64::from_le_bytes(b);
+        finite &= t.is_finite();
+        *i = u16::from_le_bytes([r[12], r[13]]);
+        if extended {
+            *a = f32::from(i16::from_le_bytes([r[18], r[19]])) * 0.006;
+            *c = (r[15] >> 4) & 3;
+            seen |= 1 << *c;
+        } else {
+            *a = f32::from(r[16] as i8);
+        }
+    }
+    (seen, finite)
 }

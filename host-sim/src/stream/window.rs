@@ -423,8 +423,6 @@ impl<'a> SectionWindow<'a> {
         let mut k = 0;
         // The forward vector of sample `k`, computed once per sample (a sine and a cosine).
         let mut forward: Option<(usize, [f64; 2])> = None;
-        // The route's sample cursor for the points' stations.
-        let mut arc = 0;
         for i in c.side()..n {
             // The trajectory's sample at or before the point's time (points come in time
             // order, so the cursor only moves on).
@@ -449,7 +447,7 @@ impl<'a> SectionWindow<'a> {
             let ahead = dx * fx + dy * fy;
             let aside = dx * fy - dy * fx;
             if ahead <= lead_max && aside.abs() <= SIDE_ASIDE_M {
-                let sp = self.route.arc_at_from(t, &mut arc).unwrap_or(0.0) + ahead;
+                let sp = self.route.arc_at_sample(t, k).unwrap_or(0.0) + ahead;
                 if sp >= from {
                     keep.push(i, sp);
                 }
@@ -641,8 +639,13 @@ impl<'a> SectionWindow<'a> {
         };
         let closed = self.close_section(edges, s0, s1);
         self.start = s1;
-        let keep = self.keep_low(keep_from, s1 - self.margin_m(), self.params.lead_max_m);
-        self.cols.evict_keeping(keep_from, keep);
+        if s1 > self.route.length_m() {
+            // The route's last section: no later section reads the side store.
+            self.cols.evict(keep_from);
+        } else {
+            let keep = self.keep_low(keep_from, s1 - self.margin_m(), self.params.lead_max_m);
+            self.cols.evict_keeping(keep_from, keep);
+        }
         closed
     }
 
