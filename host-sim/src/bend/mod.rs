@@ -18,6 +18,7 @@ pub mod climb;
 pub mod face;
 pub mod flush;
 pub mod grid;
+pub mod hole;
 pub mod leg;
 pub mod params;
 pub mod postfilter;

@@ -12,6 +12,7 @@ use super::claims::{Claims, Join};
 use super::climb::{climbed_toe, CLIMBED_SHARE};
 use super::face::face_toe_or_longer;
 use super::grid::PointGrid;
+use super::hole::{resumed_past_hole, Resumed};
 use super::leg::leg_toe;
 use super::params::{widened, BendParams};
 use super::profile::{usable, Profile, ProfileToe};
@@ -731,20 +732,48 @@ fn track_one_way(
                     *next_virtual += 1;
                     (id, toe.xyz)
                 }
-                None if gap < params.max_gap_steps => {
+                None if gap < params.max_gap_steps
+                    && !(params.weak_run_max_m > 0.0
+                        && weak_run_m + d_s > params.weak_run_max_m) =>
+                {
                     gap += 1;
                     weak_run_m += d_s;
                     weak_from.get_or_insert(picked.len());
-                    if params.weak_run_max_m > 0.0 && weak_run_m > params.weak_run_max_m {
-                        break;
-                    }
                     cur = pred;
                     let (c, sn) = (turn.cos(), turn.sin());
                     v = [c * v[0] - sn * v[1], sn * v[0] + c * v[1], v[2]];
                     continue;
                 }
+                // Where the gap steps end, a track that has followed a curb crosses a hole
+                // in the returns to where they resume on its line.
                 None => {
-                    break;
+                    let z0 = picked.last().map_or(input.z[s], |q| q.1[2]);
+                    let hole = (picked.len() + prior_steps >= CUT_MIN_TRACK_STEPS
+                        && *next_virtual < u32::MAX)
+                        .then(|| {
+                            resumed_past_hole(
+                                input,
+                                grid,
+                                [cur[0], cur[1], z0],
+                                along,
+                                turn,
+                                up,
+                                |i| own_pts.contains(&(i as u32)),
+                                params,
+                            )
+                        })
+                        .flatten();
+                    let Some(hole) = hole else { break };
+                    weak_run_m = 0.0;
+                    weak_from = None;
+                    match hole {
+                        Resumed::Point(i) => (i as u32, [input.x[i], input.y[i], input.z[i]]),
+                        Resumed::Toe(t) => {
+                            let id = *next_virtual;
+                            *next_virtual += 1;
+                            (id, t.xyz)
+                        }
+                    }
                 }
             }
         } else {
@@ -1209,6 +1238,37 @@ mod tests {
         let low = weak_line(12.0, 15.0);
         let far_low = farthest_x(&low, &params);
         assert!((11.7..12.5).contains(&far_low), "weak curb: x = {far_low}");
+    }
+
+    #[test]
+    fn a_track_crosses_a_hole_in_the_returns_to_the_curb_beyond() {
+        // The curb of `weak_line` with no return at all from x = 7 to 9 (a shadow across
+        // the road and the curb): longer than the gap steps reach, so without the hole test
+        // the track ends at x = 8.2 at the latest.
+        let mut c = weak_line(16.0, 60.0);
+        let keep: Vec<usize> = (0..c.x.len())
+            .filter(|&i| !(7.0..9.0).contains(&c.x[i]))
+            .collect();
+        macro_rules! retain {
+            ($($f:ident),*) => { $( c.$f = keep.iter().map(|&i| c.$f[i]).collect(); )* };
+        }
+        retain!(x, y, z, t, rho, status, scanline);
+        let t = track(&c, &BendParams::default());
+        let far = t.xyz.iter().map(|q| q[0]).fold(f64::MIN, f64::max);
+        assert!(far > 15.0, "stopped at x = {far}");
+        for q in &t.xyz {
+            assert!((q[1] - 5.0).abs() < 0.06, "vertex {q:?} off the toe");
+        }
+        // Where the scan ends at the hole's near side, the track ends there.
+        let mut end = weak_line(16.0, 60.0);
+        let keep: Vec<usize> = (0..end.x.len()).filter(|&i| end.x[i] < 7.0).collect();
+        let c = &mut end;
+        macro_rules! retain_end {
+            ($($f:ident),*) => { $( c.$f = keep.iter().map(|&i| c.$f[i]).collect(); )* };
+        }
+        retain_end!(x, y, z, t, rho, status, scanline);
+        let far_end = farthest_x(&end, &BendParams::default());
+        assert!(far_end < 7.5, "past the scan's end: x = {far_end}");
     }
 
     /// A toe line along y = 5 on flat ground (no step for a profile to find) seen by
