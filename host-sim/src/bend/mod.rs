@@ -19,7 +19,6 @@ pub mod face;
 pub mod flush;
 pub mod grid;
 pub mod leg;
-pub mod lip;
 pub mod params;
 pub mod postfilter;
 pub mod profile;

@@ -13,7 +13,6 @@ use super::climb::{climbed_toe, CLIMBED_SHARE};
 use super::face::face_toe_or_longer;
 use super::grid::PointGrid;
 use super::leg::leg_toe;
-use super::lip::sparse_cut_toe;
 use super::params::{widened, BendParams};
 use super::profile::{usable, Profile, ProfileToe};
 use super::seed::Seed;
@@ -675,20 +674,10 @@ fn track_one_way(
                             along: ca,
                             ..long
                         };
-                        // Where neither shows the toe, a track along the road tries the
-                        // lip's step, also on the longer profile ([`sparse_cut_toe`]).
-                        let t = on_line
-                            .cut_toe()
-                            .or_else(|| {
-                                flush_step = true;
-                                on_line.flush_toe()
-                            })
-                            .or_else(|| {
-                                flush_step = false;
-                                along_the_road(input, &picked, start, ca)
-                                    .then(|| sparse_cut_toe(&on_line))
-                                    .flatten()
-                            });
+                        let t = on_line.cut_toe().or_else(|| {
+                            flush_step = true;
+                            on_line.flush_toe()
+                        });
                         if t.is_some() {
                             cut_run_m += d_s;
                             cut_from.get_or_insert(picked.len());
