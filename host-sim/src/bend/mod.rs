@@ -12,6 +12,7 @@ use crate::io::trajectory::Trajectory;
 use crate::model::EdgeLine;
 use crate::replay::{Candidate, PointStatus};
 
+pub mod arc_seed;
 pub mod bridge;
 pub mod claims;
 pub mod climb;

@@ -10,6 +10,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
+use super::arc_seed::{arc_params, arc_seed};
 use super::face::face_toe_or_longer;
 use super::grid::PointGrid;
 use super::params::{widened, BendParams};
@@ -124,6 +125,9 @@ const SPARSE_LENGTH_FACTOR: f64 = 2.0;
 /// side (the tracker's `profile::Profile::toe_or_longer` does the same). Short stretches
 /// of curb seen between parked vehicles are then seeded as well.
 ///
+/// Where none finds a toe either, profiles turned towards a corner arc's direction are
+/// tried ([`arc_seed`]): an arc whose curb before it is never seen is reached by no track.
+///
 /// Only the interval range the input's points cover is searched, so a streaming window
 /// seeds its own stretch.
 pub fn profile_seeds(
@@ -146,6 +150,7 @@ pub fn profile_seeds(
     let l_s = params.seed_interval_m.max(1e-3);
     let half_l = 2.0 * params.profile_half_length_m;
     let wide = widened(params);
+    let arc = arc_params(params);
     // Every interval and side is searched on its own, on rayon's pool; the seeds come
     // back in interval order, left before right, whatever the threads.
     let lines: Vec<(i64, [f64; 2], [f64; 2])> = ((s0 / l_s).floor() as i64
@@ -167,21 +172,25 @@ pub fn profile_seeds(
             .filter_map(|((interval, p, fwd), (side, up))| {
                 let n = [-fwd[1] * up, fwd[0] * up];
                 let mut heights = Heights::new(params.profile_half_width_m);
-                let mut first = |params: &BendParams, half_l: f64| {
+                let mut first = |params: &BendParams, half_l: f64, along: [f64; 2]| {
                     let h = &mut heights;
                     let range = (PROFILE_SEED_NEAR_M, reach);
-                    first_toe_outward(input, grid, p, fwd, n, up, half_l, range, false, params, h)
+                    first_toe_outward(
+                        input, grid, p, along, n, up, half_l, range, false, params, h,
+                    )
                 };
-                first(params, half_l)
-                    .or_else(|| first(&wide, half_l))
-                    .or_else(|| first(params, SPARSE_LENGTH_FACTOR * half_l))
-                    .map(|point| Seed {
-                        point,
-                        side,
-                        dir: fwd,
-                        interval,
-                        inlier_ratio: 0.0,
-                    })
+                let seed = |point| Seed {
+                    point,
+                    side,
+                    dir: fwd,
+                    interval,
+                    inlier_ratio: 0.0,
+                };
+                first(params, half_l, fwd)
+                    .or_else(|| first(&wide, half_l, fwd))
+                    .or_else(|| first(params, SPARSE_LENGTH_FACTOR * half_l, fwd))
+                    .map(seed)
+                    .or_else(|| arc_seed(fwd, |along| first(&arc, half_l, along).map(seed)))
             }),
     );
     out
@@ -696,6 +705,83 @@ mod tests {
                 "seed at y = {:.3}",
                 input.y[i]
             );
+        }
+    }
+
+    #[test]
+    fn a_corner_arc_whose_curb_before_it_is_unseen_is_seeded_by_turned_profiles() {
+        use crate::io::trajectory::{Pose, Trajectory};
+        const T0: f64 = 400_000_000.0;
+        // The arc's middle: a curb at 45° to the route, y = x − 7 (toe), returns only
+        // within 1.5 m of it (the curb before it lies where the vehicle's body hides it);
+        // the curb top 0.15 m up, on the side away from the route.
+        let (mut x, mut y, mut z, mut t) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for i in 0..400 {
+            for j in 0..300 {
+                let (px, py) = (5.0 + 0.05 * f64::from(i), 0.05 * f64::from(j));
+                let off = (py - px + 7.0) / 2f64.sqrt();
+                if off.abs() > 1.5 {
+                    continue;
+                }
+                x.push(px);
+                y.push(py);
+                z.push(if off > 0.0 { 0.15 } else { 0.0 });
+                t.push(T0 + px / 10.0);
+            }
+        }
+        let points = KeptPoints {
+            t,
+            ..KeptPoints::new(x, y, z)
+        };
+        let samples = (-10..=40)
+            .map(|k| Pose {
+                t: T0 + 0.1 * f64::from(k),
+                x: f64::from(k),
+                y: 0.0,
+                z: 2.0,
+                roll_deg: 0.0,
+                pitch_deg: 0.0,
+                heading_deg: 90.0,
+            })
+            .collect();
+        let trajectory = Trajectory { samples };
+        let input = points.input(&trajectory);
+        let params = BendParams::default();
+        let grid = PointGrid::build(input.x, input.y, params.search_radius_m, |_| true);
+        let route = Route::new(&trajectory);
+        // Profiles across the route see the step spread along their length: no toe.
+        let half_l = 2.0 * params.profile_half_length_m;
+        for (p, l) in [
+            (&params, half_l),
+            (&widened(&params), half_l),
+            (&params, SPARSE_LENGTH_FACTOR * half_l),
+        ] {
+            for c in 0..10 {
+                let at = [9.0 + 2.0 * f64::from(c), 0.0];
+                let toe = first_toe_outward(
+                    &input,
+                    &grid,
+                    at,
+                    [1.0, 0.0],
+                    [0.0, 1.0],
+                    1.0,
+                    l,
+                    (PROFILE_SEED_NEAR_M, 15.0),
+                    false,
+                    p,
+                    &mut Heights::new(params.profile_half_width_m),
+                );
+                assert_eq!(toe, None, "a toe at {at:?}");
+            }
+        }
+        let seeds = profile_seeds(&input, &grid, &route, &params);
+        let left: Vec<&Seed> = seeds.iter().filter(|s| s.side == Side::Left).collect();
+        assert!(left.len() >= 4, "{} left seeds", left.len());
+        for s in left {
+            let i = s.point as usize;
+            let off = (input.y[i] - input.x[i] + 7.0) / 2f64.sqrt();
+            assert!(off.abs() <= 0.15, "seed {off:.3} m off the toe");
+            assert!((s.dir[0] - s.dir[1]).abs() < 1e-9, "direction {:?}", s.dir);
         }
     }
 
