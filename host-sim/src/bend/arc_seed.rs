@@ -14,7 +14,6 @@
 //! leg.
 
 use super::params::BendParams;
-use super::seed::Seed;
 
 /// How far the profiles are turned from the driving direction, degrees: either way, so
 /// that the arc into a side street and the arc out of it are both crossed.
@@ -37,7 +36,7 @@ pub fn arc_params(params: &BendParams) -> BendParams {
 /// The profiles' directions along the road for an arc search from a pose heading `fwd`
 /// (horizontal unit vector): `fwd` turned by [`ARC_PROFILE_TURN_DEG`] to the left, then
 /// to the right. Both keep a positive component along `fwd`, so a seed's direction taken
-/// from them runs with the driving direction as [`Seed::dir`] asks.
+/// from them runs with the driving direction as a seed's direction must.
 pub fn arc_profile_dirs(fwd: [f64; 2]) -> [[f64; 2]; 2] {
     let (s, c) = ARC_PROFILE_TURN_DEG.to_radians().sin_cos();
     [
@@ -46,13 +45,16 @@ pub fn arc_profile_dirs(fwd: [f64; 2]) -> [[f64; 2]; 2] {
     ]
 }
 
-/// The first seed that `search` (an outward search of profiles along the given direction,
-/// as `profile_seeds` makes it) finds along either of [`arc_profile_dirs`]; its direction
-/// is that profile's.
-pub fn arc_seed(fwd: [f64; 2], mut search: impl FnMut([f64; 2]) -> Option<Seed>) -> Option<Seed> {
+/// The first toe that `search` (an outward search of profiles along the given direction,
+/// as `profile_seeds` makes it) finds along either of [`arc_profile_dirs`], with that
+/// profile's direction: the seed's direction, which runs with the driving direction.
+pub fn arc_seed<T>(
+    fwd: [f64; 2],
+    mut search: impl FnMut([f64; 2]) -> Option<T>,
+) -> Option<(T, [f64; 2])> {
     arc_profile_dirs(fwd)
         .into_iter()
-        .find_map(|along| search(along).map(|s| Seed { dir: along, ..s }))
+        .find_map(|along| search(along).map(|found| (found, along)))
 }
 
 #[cfg(test)]

@@ -190,7 +190,14 @@ pub fn profile_seeds(
                     .or_else(|| first(&wide, half_l, fwd))
                     .or_else(|| first(params, SPARSE_LENGTH_FACTOR * half_l, fwd))
                     .map(seed)
-                    .or_else(|| arc_seed(fwd, |along| first(&arc, half_l, along).map(seed)))
+                    .or_else(|| {
+                        arc_seed(fwd, |along| first(&arc, half_l, along)).map(|(point, along)| {
+                            Seed {
+                                dir: along,
+                                ..seed(point)
+                            }
+                        })
+                    })
             }),
     );
     out
