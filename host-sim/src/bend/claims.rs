@@ -107,9 +107,20 @@ impl Claims {
             }
         }
         let v = self.buckets.get(&Self::cell(px, py, self.bucket_m))?;
+        self.nearest(v.iter().map(|&k| &self.segments[k as usize]), px, py, own)
+    }
+
+    /// The nearest of `segments` (in the order given) of a track other than `own` within
+    /// the join distance of `(px, py)`, ties to the lower track, then the earlier segment.
+    fn nearest<'s>(
+        &self,
+        segments: impl Iterator<Item = &'s Segment>,
+        px: f64,
+        py: f64,
+        own: usize,
+    ) -> Option<Join> {
         let mut best: Option<(f64, usize, u32)> = None;
-        for &k in v {
-            let (a, b, t) = self.segments[k as usize];
+        for &(a, b, t) in segments {
             if t == own {
                 continue;
             }
@@ -138,26 +149,7 @@ mod tests {
     /// The nearest segment within the join distance over every registered segment, in
     /// the order registered: what the buckets must find.
     fn near_by_scan(c: &Claims, px: f64, py: f64, own: usize) -> Option<Join> {
-        let mut best: Option<(f64, usize, u32)> = None;
-        for &(a, b, t) in &c.segments {
-            if t == own {
-                continue;
-            }
-            let (ax, ay) = (a.1[0], a.1[1]);
-            let (dx, dy) = (b.1[0] - ax, b.1[1] - ay);
-            let l2 = dx * dx + dy * dy;
-            let u = if l2 > 0.0 {
-                (((px - ax) * dx + (py - ay) * dy) / l2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let d = (ax + u * dx - px).hypot(ay + u * dy - py);
-            let end = if u < 0.5 { a.0 } else { b.0 };
-            if d <= c.join_m && best.is_none_or(|(bd, bt, _)| (d, t) < (bd, bt)) {
-                best = Some((d, t, end));
-            }
-        }
-        best.map(|(_, t, p)| Join { track: t, point: p })
+        c.nearest(c.segments.iter(), px, py, own)
     }
 
     #[test]
