@@ -26,7 +26,7 @@
 //! previous line, so the stream runs as one chunk.
 
 use super::line_start::{LineRule, LineStartParams};
-use super::project::PoseCursor;
+use super::project::{project_point, PoseCursor};
 use super::{Candidate, PointStatus};
 use crate::io::las_in::PointColumns;
 use crate::io::trajectory::Trajectory;
@@ -239,8 +239,7 @@ pub fn encode_stream(
     for i in range {
         let t = cols.t[i];
         let t_ns = ns_of(t, i)?;
-        let (x_m, z_m) = cur
-            .project_f32(cols.x[i], cols.y[i], cols.z[i], t)
+        let (xp, zp) = project_point(&mut cur, cols.x[i], cols.y[i], cols.z[i], t)
             .ok_or(ReplayError::Uncovered { index: i, t })?;
         let dt = t_ns
             .checked_sub(base_ns)
@@ -261,8 +260,8 @@ pub fn encode_stream(
         };
         recs.push(PointRecord {
             dt_ns: dt,
-            x_m,
-            z_m,
+            x_m: xp as f32,
+            z_m: zp as f32,
             intensity: cols.intensity[i],
             line_start: rule.is_start(i, &cols.scan_angle_deg, &cols.t),
             tag: i as u32,
@@ -322,9 +321,9 @@ fn direct_point(
 ) -> Result<(u64, PointRecord), ReplayError> {
     let t = cols.t[i];
     let t_ns = ns_of(t, i)?;
-    let (x_m, z_m) = cur
-        .project_f32(cols.x[i], cols.y[i], cols.z[i], t)
+    let (xp, zp) = project_point(cur, cols.x[i], cols.y[i], cols.z[i], t)
         .ok_or(ReplayError::Uncovered { index: i, t })?;
+    let (x_m, z_m) = (xp as f32, zp as f32);
     if !x_m.is_finite() || !z_m.is_finite() {
         return Err(ReplayError::Encode(
             curbtrace_core::wire::EncodeError::NonFinite { index: i },
