@@ -7,9 +7,9 @@
 //! with their channel key     last line carried on                  vehicle passes them   boundaries
 //! ```
 //!
-//! The stages are joined by bounded channels (a few batches from the reader, one from the
-//! core stage), so decoding runs beside the core and the tracker, and memory holds a few
-//! batches and one window:
+//! The stages are joined by bounded channels (a batch from the reader, a few batches'
+//! points from the core stage, [`queue`]), so decoding and the core run beside the
+//! tracker, and memory holds a few batches and one window:
 //! it does not grow with the input. Inputs not in time order are detected by the source
 //! and the run starts again on a chunk-wise external sort (see `source::external_sort`).
 //!
