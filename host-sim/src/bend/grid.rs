@@ -52,7 +52,7 @@ impl PointGrid {
     ///
     /// `keep` is asked once per point; the answers are kept as a bitmap (one bit per point)
     /// for the two passes of the counting sort.
-    pub fn build(x: &[f64], y: &[f64], cell_m: f64, keep: impl Fn(usize) -> bool) -> Self {
+    pub fn build(x: &[f64], y: &[f64], cell_m: f64, keep: impl Fn(usize) -> bool + Sync) -> Self {
         let mut g = Self {
             origin: 0,
             slabs: Vec::new(),
@@ -64,7 +64,13 @@ impl PointGrid {
 
     /// [`build`](Self::build) in place: the same index, in the cell and order arrays this
     /// grid already holds (one slab over every point).
-    pub fn rebuild(&mut self, x: &[f64], y: &[f64], cell_m: f64, keep: impl Fn(usize) -> bool) {
+    pub fn rebuild(
+        &mut self,
+        x: &[f64],
+        y: &[f64],
+        cell_m: f64,
+        keep: impl Fn(usize) -> bool + Sync,
+    ) {
         let n = x.len().min(y.len()).min(u32::MAX as usize - 1);
         self.origin = 0;
         self.retire(|_| true);
@@ -87,7 +93,7 @@ impl PointGrid {
         origin: u64,
         cut: Option<usize>,
         cell_m: f64,
-        keep: impl Fn(usize) -> bool,
+        keep: impl Fn(usize) -> bool + Sync,
     ) {
         let n = x.len().min(y.len()).min(u32::MAX as usize - 1);
         let (x, y) = (&x[..n], &y[..n]);
@@ -141,7 +147,7 @@ impl PointGrid {
         lo: usize,
         hi: usize,
         cell_m: f64,
-        keep: &impl Fn(usize) -> bool,
+        keep: &(impl Fn(usize) -> bool + Sync),
     ) {
         let best = (0..self.spare.len()).max_by_key(|&k| self.spare[k].order.capacity());
         let mut s = best.map_or_else(Slab::default, |k| self.spare.swap_remove(k));
@@ -282,29 +288,43 @@ impl PointGrid {
 
 impl Slab {
     /// Indexes the points `i` of `x`, `y` with `keep(i)` true and finite coordinates.
-    fn index(&mut self, x: &[f64], y: &[f64], cell_m: f64, keep: impl Fn(usize) -> bool) {
+    ///
+    /// A slab of [`HALVES_MIN_POINTS`] or more is indexed in two halves on two threads
+    /// (rayon's pool): each half of the points finds its box and its points' cells, and
+    /// each half of the cells takes its points in one walk over all of them in order, so
+    /// the index is the one a single thread builds.
+    fn index(&mut self, x: &[f64], y: &[f64], cell_m: f64, keep: impl Fn(usize) -> bool + Sync) {
+        let halves = x.len().min(y.len()) >= HALVES_MIN_POINTS;
+        self.index_in(x, y, cell_m, keep, halves);
+    }
+
+    /// [`index`](Self::index), in two halves when `halves`.
+    fn index_in(
+        &mut self,
+        x: &[f64],
+        y: &[f64],
+        cell_m: f64,
+        keep: impl Fn(usize) -> bool + Sync,
+        halves: bool,
+    ) {
         let n = x.len().min(y.len());
         let (x, y) = (&x[..n], &y[..n]);
         let mut kept = vec![0u64; n.div_ceil(64)];
-        let (mut x0, mut y0, mut x1, mut y1) = (
-            f64::INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NEG_INFINITY,
+        // The second half's points start at a word of the bitmap.
+        let mid_w = if halves { kept.len() / 2 } else { kept.len() };
+        let (ka, kb) = kept.split_at_mut(mid_w);
+        let (a, b) = both(
+            halves,
+            || Bounds::scan(x, y, 0, ka, &keep),
+            || Bounds::scan(x, y, mid_w * 64, kb, &keep),
         );
-        let mut count = 0usize;
-        for (i, (&px, &py)) in x.iter().zip(y).enumerate() {
-            if px.is_finite() && py.is_finite() && keep(i) {
-                kept[i >> 6] |= 1 << (i & 63);
-                // Finite values: a comparison and a select (one instruction each on
-                // x86-64), where `f64::min` and `max` also handle NaN.
-                x0 = if px < x0 { px } else { x0 };
-                y0 = if py < y0 { py } else { y0 };
-                x1 = if px > x1 { px } else { x1 };
-                y1 = if py > y1 { py } else { y1 };
-                count += 1;
-            }
-        }
+        let (x0, y0, x1, y1) = (
+            a.x0.min(b.x0),
+            a.y0.min(b.y0),
+            a.x1.max(b.x1),
+            a.y1.max(b.y1),
+        );
+        let count = a.count + b.count;
         let mut cell = if cell_m.is_finite() && cell_m > 0.0 {
             cell_m
         } else {
@@ -326,36 +346,54 @@ impl Slab {
         } {
             cell *= 1.5;
         }
-        let (a, b) = dims(cell);
-        let (nx, ny) = (a as usize, b as usize);
+        let (a_n, b_n) = dims(cell);
+        let (nx, ny) = (a_n as usize, b_n as usize);
         (self.cell_m, self.x0, self.y0, self.nx, self.ny) = (cell, x0, y0, nx, ny);
         (self.x1, self.y1) = (x1, y1);
         self.starts.resize(nx * ny + 1, 0);
         // Each kept point's cell, found once for the count and kept for the scatter (4
         // bytes a kept point while the grid is built).
         let cells = CellOf::new(self);
+        let mut cell_of = vec![0u32; count];
+        {
+            let (ca, cb) = cell_of.split_at_mut(a.count);
+            let (ka, kb) = kept.split_at(mid_w);
+            let cells = &cells;
+            both(
+                halves,
+                || cells.of_set(x, y, 0, ka, ca),
+                || cells.of_set(x, y, mid_w * 64, kb, cb),
+            );
+        }
         let starts = &mut self.starts;
-        let mut cell_of = Vec::with_capacity(count);
-        for_each_set(&kept, |i| {
-            let c = cells.at(x[i], y[i]);
-            starts[c + 1] += 1;
-            cell_of.push(c as u32);
-        });
+        for &c in &cell_of {
+            starts[c as usize + 1] += 1;
+        }
         // Prefix sums: `starts[c + 1]` is where cell c + 1 begins. The scatter moves each
         // cell's start on to its end; one shift back gives the starts again.
-        for c in 0..nx * ny {
+        let ncell = nx * ny;
+        for c in 0..ncell {
             starts[c + 1] += starts[c];
         }
         self.order.resize(count, 0);
-        let order = &mut self.order;
-        let mut k = 0;
-        for_each_set(&kept, |i| {
-            let c = cell_of[k] as usize;
-            k += 1;
-            order[starts[c] as usize] = i as u32;
-            starts[c] += 1;
-        });
-        starts.copy_within(0..nx * ny, 1);
+        // The cells below `cm` take the first part of `order`, the others the rest.
+        let cm = if halves {
+            starts
+                .partition_point(|&s| (s as usize) < count / 2)
+                .min(ncell)
+        } else {
+            ncell
+        };
+        let base = starts[cm] as usize;
+        let (oa, ob) = self.order.split_at_mut(base);
+        let (sa, sb) = starts.split_at_mut(cm);
+        let (kept, cell_of) = (&kept, &cell_of);
+        both(
+            halves,
+            || scatter(kept, cell_of, 0..cm, sa, oa, 0),
+            || scatter(kept, cell_of, cm..ncell, sb, ob, base),
+        );
+        starts.copy_within(0..ncell, 1);
         starts[0] = 0;
     }
 
@@ -509,6 +547,94 @@ fn for_each_set(bits: &[u64], mut f: impl FnMut(usize)) {
     }
 }
 
+/// Slabs of at least this many points are indexed on two threads: below it the second
+/// thread's start costs more than it saves.
+const HALVES_MIN_POINTS: usize = 1 << 16;
+
+/// `(a(), b())`, side by side on rayon's pool when `two`.
+fn both<A: Send, B: Send>(
+    two: bool,
+    a: impl FnOnce() -> A + Send,
+    b: impl FnOnce() -> B + Send,
+) -> (A, B) {
+    if two {
+        rayon::join(a, b)
+    } else {
+        (a(), b())
+    }
+}
+
+/// The box and number of a run of points kept for a slab.
+struct Bounds {
+    x0: f64,
+    y0: f64,
+    x1: f64,
+    y1: f64,
+    count: usize,
+}
+
+impl Bounds {
+    /// Marks in `bits` (the bitmap's words from point `from` on) the points of `x`, `y`
+    /// from `from` with `keep(i)` true and finite coordinates, and returns their box.
+    fn scan(
+        x: &[f64],
+        y: &[f64],
+        from: usize,
+        bits: &mut [u64],
+        keep: impl Fn(usize) -> bool,
+    ) -> Self {
+        let mut b = Self {
+            x0: f64::INFINITY,
+            y0: f64::INFINITY,
+            x1: f64::NEG_INFINITY,
+            y1: f64::NEG_INFINITY,
+            count: 0,
+        };
+        let n = x.len().min(y.len());
+        let (from, to) = (from.min(n), (from + bits.len() * 64).min(n));
+        for (j, (&px, &py)) in x[from..to].iter().zip(&y[from..to]).enumerate() {
+            let i = from + j;
+            if px.is_finite() && py.is_finite() && keep(i) {
+                bits[(i - from) >> 6] |= 1 << (i & 63);
+                // Finite values: a comparison and a select (one instruction each on
+                // x86-64), where `f64::min` and `max` also handle NaN.
+                b.x0 = if px < b.x0 { px } else { b.x0 };
+                b.y0 = if py < b.y0 { py } else { b.y0 };
+                b.x1 = if px > b.x1 { px } else { b.x1 };
+                b.y1 = if py > b.y1 { py } else { b.y1 };
+                b.count += 1;
+            }
+        }
+        b
+    }
+}
+
+/// Places every kept point (in `bits`, ascending; `cell_of` its cell) whose cell lies in
+/// `cells`: at `at[c − cells.start]` in `order`, which begins at `base` of the whole
+/// order, moving that position on.
+fn scatter(
+    bits: &[u64],
+    cell_of: &[u32],
+    cells: std::ops::Range<usize>,
+    at: &mut [u32],
+    order: &mut [u32],
+    base: usize,
+) {
+    if cells.is_empty() {
+        return;
+    }
+    let mut k = 0;
+    for_each_set(bits, |i| {
+        let c = cell_of[k] as usize;
+        k += 1;
+        if cells.contains(&c) {
+            let p = &mut at[c - cells.start];
+            order[*p as usize - base] = i as u32;
+            *p += 1;
+        }
+    });
+}
+
 /// The cell of a point inside the grid's box: `⌊(v − v0) / cell⌋` on each axis, clamped to
 /// the last cell. A multiplication by the reciprocal gives the same floor unless the
 /// quotient lies within 10⁻⁶ of an integer (product and quotient differ by a few ulp,
@@ -561,6 +687,17 @@ impl CellOf {
 
     fn at(&self, x: f64, y: f64) -> usize {
         self.axis(y - self.y0, self.ny) * self.nx + self.axis(x - self.x0, self.nx)
+    }
+
+    /// The cell of every point set in `bits` (the bitmap's words from point `from` on),
+    /// in order, into `out`.
+    fn of_set(&self, x: &[f64], y: &[f64], from: usize, bits: &[u64], out: &mut [u32]) {
+        let mut k = 0;
+        for_each_set(bits, |j| {
+            let i = from + j;
+            out[k] = self.at(x[i], y[i]) as u32;
+            k += 1;
+        });
     }
 }
 
@@ -782,6 +919,36 @@ mod tests {
                 assert_eq!(got, want, "cell {cell}, angle {th}");
                 assert!(want.len() > 50, "{}", want.len());
             }
+        }
+    }
+
+    #[test]
+    fn a_slab_indexed_in_halves_is_the_slab_indexed_on_one_thread() {
+        // A scatter over a street's width with points left out and non-finite ones, so
+        // that the halves' boxes and counts differ; odd lengths cut the bitmap's last word.
+        for n in [HALVES_MIN_POINTS + 37, 3 * HALVES_MIN_POINTS + 1] {
+            let x: Vec<f64> = (0..n as u32)
+                .map(|k| 455_000.0 + f64::from(k.wrapping_mul(2_654_435_761) % 60_001) * 1e-3)
+                .collect();
+            let mut y: Vec<f64> = (0..n as u32)
+                .map(|k| 3_951_000.0 + f64::from(k) * 1e-4 + f64::from(k % 7) * 0.3)
+                .collect();
+            y[n / 3] = f64::NAN;
+            let keep = |i: usize| i % 13 != 5;
+            let (mut one, mut two) = (Slab::default(), Slab::default());
+            one.index_in(&x, &y, 0.1, keep, false);
+            two.index_in(&x, &y, 0.1, keep, true);
+            let kept = (0..n).filter(|&i| keep(i) && i != n / 3).count();
+            assert_eq!(one.order.len(), kept);
+            assert_eq!(one.order, two.order);
+            assert_eq!(one.starts, two.starts);
+            assert_eq!(
+                (one.cell_m, one.x0, one.y0, one.x1, one.y1, one.nx, one.ny),
+                (two.cell_m, two.x0, two.y0, two.x1, two.y1, two.nx, two.ny)
+            );
+            // Cells ascending, indices ascending within a cell.
+            assert!(one.starts.windows(2).all(|w| w[0] <= w[1]));
+            assert!(one.nx * one.ny > 1_000);
         }
     }
 

@@ -7,9 +7,9 @@
 //! with their channel key     last line carried on                  vehicle passes them   boundaries
 //! ```
 //!
-//! The stages are joined by bounded channels (a few batches from the reader, one from the
-//! core stage), so decoding runs beside the core and the tracker, and memory holds a few
-//! batches and one window:
+//! The stages are joined by bounded channels (a batch from the reader, a few batches'
+//! points from the core stage, [`queue`]), so decoding and the core run beside the
+//! tracker, and memory holds a few batches and one window:
 //! it does not grow with the input. Inputs not in time order are detected by the source
 //! and the run starts again on a chunk-wise external sort (see `source::external_sort`).
 //!
@@ -21,12 +21,14 @@
 //! - [`passes`] — a trajectory that drives the same road again cut into passes.
 //! - [`fuse`] — the edges of several scanners (channels) and passes made one edge per curb.
 //! - [`tasks`] — the campaign cut into independent tasks of whole sections, merged after.
+//! - [`queue`] — a channel bounded by the points it holds.
 
 pub mod core_stage;
 pub mod fuse;
 pub mod malloc;
 pub mod merge;
 pub mod passes;
+pub mod queue;
 pub mod ring_stage;
 pub mod tasks;
 pub mod window;
@@ -53,12 +55,17 @@ pub use window::WindowParams;
 /// Points per batch the reader hands to the core stage.
 pub const STREAM_BATCH_POINTS: usize = BATCH_POINTS;
 
-/// Batches the reader may decode ahead of the core stage (about 1.3 MB each). The window
-/// runs a section at a time, and the parts of a section that run on one thread hold up
-/// the core stage and, through it, the reader: with a single batch in flight the decoder
-/// stood idle for most of each section, with a few it keeps decoding
-/// (docs/benchmarks.md).
-const READ_AHEAD_BATCHES: usize = 4;
+/// Batches the reader may decode ahead of the core stage (about 1.3 MB each). The reader
+/// keeps pace with the core stage; the room for the decoder to run on while the window
+/// runs a section is after the core ([`WINDOW_QUEUE_POINTS`]).
+const READ_AHEAD_BATCHES: usize = 1;
+
+/// Points the core stage may run ahead of the window (about 41 B each). The window runs a
+/// section at a time, and the parts of a section that run on one thread held up the core
+/// stage and, through it, the reader: with room for the core's output the decoder and
+/// the core keep running beside a section, and a batch waiting there has had both the
+/// decoder's and the core's work done (docs/benchmarks.md).
+const WINDOW_QUEUE_POINTS: usize = 5 * STREAM_BATCH_POINTS;
 
 /// What one pass over a source produced.
 struct Pass {
@@ -610,7 +617,8 @@ fn run_pass(
     let read_thread_cpu = AtomicU64::new(0);
     std::thread::scope(|s| {
         let (tx_b, rx_b) = sync_channel::<Result<PointBatch, SourceError>>(READ_AHEAD_BATCHES);
-        let (tx_c, rx_c) = sync_channel::<Result<core_stage::CoreBatch, PassError>>(1);
+        let (tx_c, rx_c) =
+            queue::channel::<Result<core_stage::CoreBatch, PassError>>(WINDOW_QUEUE_POINTS);
         let bytes_done = &bytes_done;
         let (read_s, core_s, read_thread_cpu) = (&read_s, &core_s, &read_thread_cpu);
         let read_wait_s = &read_wait_s;
@@ -658,7 +666,7 @@ fn run_pass(
                     let b = match b {
                         Ok(b) => b,
                         Err(e) => {
-                            let _ = tx_c.send(Err(PassError::Source(e)));
+                            let _ = tx_c.send(Err(PassError::Source(e)), 0);
                             return None;
                         }
                     };
@@ -668,13 +676,14 @@ fn run_pass(
                     match out {
                         Ok(cs) => {
                             for c in cs {
-                                if tx_c.send(Ok(c)).is_err() {
+                                let n = c.t.len();
+                                if tx_c.send(Ok(c), n).is_err() {
                                     return None;
                                 }
                             }
                         }
                         Err(e) => {
-                            let _ = tx_c.send(Err(PassError::Core(e)));
+                            let _ = tx_c.send(Err(PassError::Core(e)), 0);
                             return None;
                         }
                     }
@@ -682,11 +691,12 @@ fn run_pass(
                 let t0 = Instant::now();
                 match stage.finish() {
                     Ok(Some(c)) => {
-                        let _ = tx_c.send(Ok(c));
+                        let n = c.t.len();
+                        let _ = tx_c.send(Ok(c), n);
                     }
                     Ok(None) => {}
                     Err(e) => {
-                        let _ = tx_c.send(Err(PassError::Core(e)));
+                        let _ = tx_c.send(Err(PassError::Core(e)), 0);
                         return None;
                     }
                 }

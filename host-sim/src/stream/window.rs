@@ -402,58 +402,9 @@ impl<'a> SectionWindow<'a> {
         self.thinned = s1;
     }
 
-    /// The first `n` points to keep in the side store: those of the store that lie at or
-    /// after station `from`, and the others near the road's level (at most
-    /// [`LOW_ABOVE_M`] above the trajectory) within [`SIDE_ASIDE_M`] aside of the vehicle,
-    /// at most `lead_max` ahead of it, that lie at or after `from` (the vehicle's station
-    /// and how far ahead of it the point lies).
+    /// [`keep_low`] on this window's points.
     fn keep_low(&self, n: usize, from: f64, lead_max: f64) -> Keep {
-        let c = &self.cols;
-        let n = n.min(c.len());
-        let mut keep = Keep::new(n);
-        for (i, &sp) in c.side_sp.iter().enumerate().take(n) {
-            if f64::from(sp) >= from {
-                keep.push(i, f64::from(sp));
-            }
-        }
-        if lead_max.is_nan() || lead_max <= 0.0 {
-            return keep;
-        }
-        let samples = &self.traj.samples;
-        let mut k = 0;
-        // The forward vector of sample `k`, computed once per sample (a sine and a cosine).
-        let mut forward: Option<(usize, [f64; 2])> = None;
-        for i in c.side()..n {
-            // The trajectory's sample at or before the point's time (points come in time
-            // order, so the cursor only moves on).
-            let t = c.t[i];
-            while k + 1 < samples.len() && samples[k + 1].t <= t {
-                k += 1;
-            }
-            let Some(p) = samples.get(k) else { break };
-            let above = c.z[i] - p.z;
-            if above.is_nan() || above > LOW_ABOVE_M {
-                continue;
-            }
-            let [fx, fy] = match forward {
-                Some((j, f)) if j == k => f,
-                _ => {
-                    let f = p.forward();
-                    forward = Some((k, f));
-                    f
-                }
-            };
-            let (dx, dy) = (c.x[i] - p.x, c.y[i] - p.y);
-            let ahead = dx * fx + dy * fy;
-            let aside = dx * fy - dy * fx;
-            if ahead <= lead_max && aside.abs() <= SIDE_ASIDE_M {
-                let sp = self.route.arc_at_sample(t, k).unwrap_or(0.0) + ahead;
-                if sp >= from {
-                    keep.push(i, sp);
-                }
-            }
-        }
-        keep
+        keep_low(&self.cols, self.traj, &self.route, n, from, lead_max)
     }
 
     fn station(&self, t: f64) -> f64 {
@@ -632,19 +583,30 @@ impl<'a> SectionWindow<'a> {
     fn run_section(&mut self, s1: f64) -> Vec<EdgeLine> {
         let s0 = self.start;
         let (lo, hi, keep_from) = self.section_points(s0, s1);
-        let edges = if hi > lo {
-            self.extract_range(lo, hi, keep_from.checked_sub(lo))
-        } else {
-            Vec::new()
-        };
+        // The route's last section: no later section reads the side store.
+        let last = s1 > self.route.length_m();
+        let (from, lead_max) = (s1 - self.margin_m(), self.params.lead_max_m);
+        // The points to keep in the side store depend on the window's points alone, not
+        // on the section's edges: they are found beside the section's parts that run on
+        // one thread (the grid's slide, the tracker).
+        let (cols, traj, route, bend) = (&self.cols, self.traj, &self.route, &self.bend);
+        let grid = &mut self.grid;
+        let (edges, keep) = rayon::join(
+            || {
+                if hi > lo {
+                    let cut = keep_from.checked_sub(lo);
+                    extract_on(cols, traj, route, bend, grid, lo, hi, cut)
+                } else {
+                    Vec::new()
+                }
+            },
+            || (!last).then(|| keep_low(cols, traj, route, keep_from, from, lead_max)),
+        );
         let closed = self.close_section(edges, s0, s1);
         self.start = s1;
-        if s1 > self.route.length_m() {
-            // The route's last section: no later section reads the side store.
-            self.cols.evict(keep_from);
-        } else {
-            let keep = self.keep_low(keep_from, s1 - self.margin_m(), self.params.lead_max_m);
-            self.cols.evict_keeping(keep_from, keep);
+        match keep {
+            Some(keep) => self.cols.evict_keeping(keep_from, keep),
+            None => self.cols.evict(keep_from),
         }
         closed
     }
@@ -694,6 +656,66 @@ impl<'a> SectionWindow<'a> {
             cut,
         )
     }
+}
+
+/// The first `n` points of `c` to keep in the side store: those of the store that lie at or
+/// after station `from`, and the others near the road's level (at most
+/// [`LOW_ABOVE_M`] above the trajectory) within [`SIDE_ASIDE_M`] aside of the vehicle,
+/// at most `lead_max` ahead of it, that lie at or after `from` (the vehicle's station
+/// and how far ahead of it the point lies).
+fn keep_low(
+    c: &Columns,
+    traj: &Trajectory,
+    route: &Route,
+    n: usize,
+    from: f64,
+    lead_max: f64,
+) -> Keep {
+    let n = n.min(c.len());
+    let mut keep = Keep::new(n);
+    for (i, &sp) in c.side_sp.iter().enumerate().take(n) {
+        if f64::from(sp) >= from {
+            keep.push(i, f64::from(sp));
+        }
+    }
+    if lead_max.is_nan() || lead_max <= 0.0 {
+        return keep;
+    }
+    let samples = &traj.samples;
+    let mut k = 0;
+    // The forward vector of sample `k`, computed once per sample (a sine and a cosine).
+    let mut forward: Option<(usize, [f64; 2])> = None;
+    for i in c.side()..n {
+        // The trajectory's sample at or before the point's time (points come in time
+        // order, so the cursor only moves on).
+        let t = c.t[i];
+        while k + 1 < samples.len() && samples[k + 1].t <= t {
+            k += 1;
+        }
+        let Some(p) = samples.get(k) else { break };
+        let above = c.z[i] - p.z;
+        if above.is_nan() || above > LOW_ABOVE_M {
+            continue;
+        }
+        let [fx, fy] = match forward {
+            Some((j, f)) if j == k => f,
+            _ => {
+                let f = p.forward();
+                forward = Some((k, f));
+                f
+            }
+        };
+        let (dx, dy) = (c.x[i] - p.x, c.y[i] - p.y);
+        let ahead = dx * fx + dy * fy;
+        let aside = dx * fy - dy * fx;
+        if ahead <= lead_max && aside.abs() <= SIDE_ASIDE_M {
+            let sp = route.arc_at_sample(t, k).unwrap_or(0.0) + ahead;
+            if sp >= from {
+                keep.push(i, sp);
+            }
+        }
+    }
+    keep
 }
 
 /// The bend method on the points `lo..hi` of `c`, indexed by `grid`: its slabs that lie in
