@@ -21,6 +21,7 @@ pub mod flush;
 pub mod grid;
 pub mod hole;
 pub mod leg;
+pub mod leg_seed;
 pub mod params;
 pub mod postfilter;
 pub mod profile;
@@ -170,6 +171,7 @@ pub fn extract_edges_on_grid(
     let from_profiles = seed::profile_seeds(&input, grid, route, params);
     seeds.extend(from_profiles);
     seeds.extend(seed::end_seeds(&input, grid, route, params));
+    seeds.extend(leg_seed::leg_seeds(&input, grid, route, params));
     // Best-fitting seeds first: the first track along a curb claims it, later seeds on the
     // same curb start nothing.
     seeds.sort_by(|a, b| {

@@ -1,0 +1,231 @@
+//! Seeds on side streets' legs: virtual profiles laid along the route's normal, so that
+//! they cross a curb that runs away from the route.
+//!
+//! The core's candidates come from bend angles along the scanlines, and a scanline that
+//! runs beside a side street's curb bends nowhere at its toe; the profile seeds
+//! ([`super::seed::profile_seeds`]) are profiles across the driving direction, which see a
+//! curb parallel to the route and not one at a large angle to it. A leg left unseeded is
+//! never tracked, unless a track comes round its corner and follows it all the way. Here,
+//! on lines parallel to the route at a few distances aside, profiles whose own length runs
+//! along the route's normal (their step across runs along the route, either way up) look
+//! for the leg's toe; the first toe found at each distance gives a seed, so a leg that a
+//! track leaves at a hole in the returns is seeded again beyond it. Only the stretch of
+//! route the input's points cover is searched (a streaming window seeds its own stretch),
+//! and the seeds come last in tracking, after the profile seeds: they start tracks only
+//! where no other track has claimed the curb.
+
+use rayon::prelude::*;
+
+use super::grid::PointGrid;
+use super::params::BendParams;
+use super::profile::{usable, Profile};
+use super::route::Route;
+use super::seed::{nearest_usable, Seed};
+use super::BendInput;
+use crate::model::Side;
+
+/// Nearest distance aside of the route at which a leg is looked for, metres: nearer lie
+/// the vehicle's lane and the corner's arc, which the other seeds reach.
+const LEG_NEAR_M: f64 = 2.0;
+
+/// Farthest distance aside of the route at which a leg is looked for, metres: a profiler
+/// sees side streets' legs 10–25 m aside in plain view, farther than the profile seeds'
+/// reach (`profile_seed_reach_m`) across the road.
+const LEG_REACH_M: f64 = 30.0;
+
+/// Step between the distances aside that are searched, metres: a seed anywhere on a leg is
+/// enough for the tracker to follow it, so the lines need not cover the leg.
+const LEG_STEP_ASIDE_M: f64 = 1.5;
+
+/// Step between profiles along the route on one line, metres: a profile finds a toe within
+/// 0.3 m of its centre (`profile_half_width_m` less the 0.15 m kept clear), so 0.5 m steps
+/// leave no leg crossing the line unseen.
+const LEG_STEP_ALONG_M: f64 = 0.5;
+
+/// Turns of the profiles' length from the route's normal that are tried, degrees, in
+/// order: side streets meet the road at angles other than right ones, and a profile 0.6 m
+/// long sees a toe only on a curb within about 10° of its length.
+const LEG_TURNS_DEG: [f64; 5] = [0.0, 20.0, -20.0, 40.0, -40.0];
+
+/// The ground height at `centre` for a leg's profile: the median height of the usable
+/// points within the profile's half-width, `None` with fewer than 8 of them or where
+/// their 5th and 95th percentile heights lie less than half the least curb step apart
+/// (no step within reach: the profiles are not tried). The heights are gathered in `z`.
+fn stepped_ground(
+    input: &BendInput,
+    grid: &PointGrid,
+    centre: [f64; 2],
+    params: &BendParams,
+    z: &mut Vec<f64>,
+) -> Option<f64> {
+    z.clear();
+    let r = params.profile_half_width_m;
+    grid.for_each_within(input.x, input.y, centre[0], centre[1], r, |i| {
+        if usable(input, i) && input.z[i].is_finite() {
+            z.push(input.z[i]);
+        }
+    });
+    if z.len() < 8 {
+        return None;
+    }
+    z.sort_unstable_by(f64::total_cmp);
+    let at = |q: f64| z[((z.len() - 1) as f64 * q).round() as usize];
+    (at(0.95) - at(0.05) >= 0.5 * params.profile_min_step_m).then(|| at(0.5))
+}
+
+/// Seeds on legs (see the module docs), in interval order, left before right.
+///
+/// For each interval of L_s along the route and each side, profiles centred on the ground
+/// (the median height within the profile's half-width) at [`LEG_STEP_ALONG_M`] along the
+/// interval and [`LEG_STEP_ASIDE_M`] aside from [`LEG_NEAR_M`] to [`LEG_REACH_M`]
+/// are tried, turned by [`LEG_TURNS_DEG`], with the step rising either way (`Profile::toe`),
+/// where the ground there shows a step ([`stepped_ground`]); the first
+/// toe on a line gives a seed on the usable point nearest to it, its direction the route's
+/// normal, inlier share 0.
+pub fn leg_seeds(
+    input: &BendInput,
+    grid: &PointGrid,
+    route: &Route,
+    params: &BendParams,
+) -> Vec<Seed> {
+    let reach = LEG_REACH_M;
+    let finite_t = || input.t.iter().copied().filter(|t| t.is_finite());
+    let (Some(t0), Some(t1)) = (finite_t().reduce(f64::min), finite_t().reduce(f64::max)) else {
+        return Vec::new();
+    };
+    let (Some(s0), Some(s1)) = (route.arc_at(t0), route.arc_at(t1)) else {
+        return Vec::new();
+    };
+    let l_s = params.seed_interval_m.max(1e-3);
+    let half_l = 2.0 * params.profile_half_length_m;
+    let per_interval = (l_s / LEG_STEP_ALONG_M).ceil().max(1.0) as usize;
+    let intervals: Vec<i64> = ((s0 / l_s).floor() as i64..=(s1 / l_s).floor() as i64).collect();
+    let sides = [(Side::Left, 1.0), (Side::Right, -1.0)];
+    let mut out: Vec<Seed> = intervals
+        .par_iter()
+        .flat_map_iter(|&interval| sides.iter().map(move |&s| (interval, s)))
+        .flat_map_iter(|(interval, (side, sign))| {
+            // The poses along the interval, within the stretch the points cover.
+            let poses: Vec<([f64; 2], [f64; 2])> = (0..per_interval)
+                .filter_map(|k| {
+                    let s = interval as f64 * l_s + (k as f64 + 0.5) * LEG_STEP_ALONG_M;
+                    if s < s0 || s > s1 || s >= (interval + 1) as f64 * l_s {
+                        return None;
+                    }
+                    route.pose_at_arc(s)
+                })
+                .collect();
+            let mut seeds = Vec::new();
+            let mut z = Vec::new();
+            let mut c = LEG_NEAR_M;
+            while c <= reach {
+                let found = poses.iter().find_map(|&(p, fwd)| {
+                    let n = [-fwd[1] * sign, fwd[0] * sign];
+                    let centre = [p[0] + c * n[0], p[1] + c * n[1]];
+                    let ground = stepped_ground(input, grid, centre, params, &mut z)?;
+                    let toe = LEG_TURNS_DEG.iter().find_map(|&turn| {
+                        let (sin, cos) = f64::to_radians(turn).sin_cos();
+                        let along = [n[0] * cos - n[1] * sin, n[0] * sin + n[1] * cos];
+                        [1.0, -1.0].into_iter().find_map(|up| {
+                            Profile {
+                                input,
+                                grid,
+                                params,
+                                centre: [centre[0], centre[1], ground],
+                                along,
+                                up,
+                                half_l,
+                            }
+                            .toe()
+                        })
+                    })?;
+                    nearest_usable(input, grid, toe.xyz, params.search_radius_m)
+                        .map(|point| (point, n))
+                });
+                if let Some((point, n)) = found {
+                    seeds.push(Seed {
+                        point,
+                        side,
+                        dir: n,
+                        interval,
+                        inlier_ratio: 0.0,
+                    });
+                }
+                c += LEG_STEP_ASIDE_M;
+            }
+            seeds
+        })
+        .collect();
+    out.dedup_by_key(|s| s.point);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bend::fixture::KeptPoints;
+    use crate::bend::seed::profile_seeds;
+    use crate::io::trajectory::{Pose, Trajectory};
+
+    /// A side street's leg left of a drive east along y = 0: the road level west of
+    /// x = 10 m, the sidewalk 0.12 m up east of it, from y = 3 m to 12 m aside, sampled on a
+    /// 0.08 m grid. The leg's curb runs along the route's normal: the profile seeds see no
+    /// toe there, the leg seeds put one on it.
+    #[test]
+    fn a_leg_at_right_angles_to_the_route_is_seeded() {
+        const T0: f64 = 400_000_000.0;
+        let (mut x, mut y, mut z, mut t) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for i in 0..250 {
+            let px = 0.08 * f64::from(i);
+            for j in 0..113 {
+                let py = 3.0 + 0.08 * f64::from(j);
+                x.push(px);
+                y.push(py);
+                z.push(if px < 10.0 {
+                    0.0
+                } else {
+                    0.12 + 0.02 * (px - 10.0)
+                });
+                t.push(T0 + px / 10.0);
+            }
+        }
+        let points = KeptPoints {
+            t,
+            ..KeptPoints::new(x, y, z)
+        };
+        let samples = (-10..=40)
+            .map(|k| Pose {
+                t: T0 + 0.1 * f64::from(k),
+                x: f64::from(k),
+                y: 0.0,
+                z: 2.0,
+                roll_deg: 0.0,
+                pitch_deg: 0.0,
+                heading_deg: 90.0,
+            })
+            .collect();
+        let trajectory = Trajectory { samples };
+        let input = points.input(&trajectory);
+        let params = BendParams::default();
+        let grid = PointGrid::build(input.x, input.y, params.search_radius_m, |_| true);
+        let route = Route::new(&trajectory);
+        let across = profile_seeds(&input, &grid, &route, &params);
+        assert!(across.is_empty(), "{} profile seeds", across.len());
+        let seeds = leg_seeds(&input, &grid, &route, &params);
+        assert!(seeds.len() >= 4, "{} leg seeds", seeds.len());
+        for s in &seeds {
+            let i = s.point as usize;
+            assert_eq!(s.side, Side::Left);
+            assert!(
+                (input.x[i] - 10.0).abs() <= 0.1,
+                "seed at x = {:.3}",
+                input.x[i]
+            );
+            assert!(
+                s.dir[0].abs() < 1e-6 && (s.dir[1] - 1.0).abs() < 1e-6,
+                "{:?}",
+                s.dir
+            );
+        }
+    }
+}
