@@ -171,7 +171,6 @@ pub fn extract_edges_on_grid(
     let from_profiles = seed::profile_seeds(&input, grid, route, params);
     seeds.extend(from_profiles);
     seeds.extend(seed::end_seeds(&input, grid, route, params));
-    seeds.extend(leg_seed::leg_seeds(&input, grid, route, params));
     // Best-fitting seeds first: the first track along a curb claims it, later seeds on the
     // same curb start nothing.
     seeds.sort_by(|a, b| {
@@ -181,6 +180,9 @@ pub fn extract_edges_on_grid(
             .then(a.interval.cmp(&b.interval))
             .then(a.point.cmp(&b.point))
     });
+    // Seeds on side streets' legs come after all others: they start tracks only on curbs
+    // that no other seed's track reaches.
+    seeds.extend(leg_seed::leg_seeds(&input, grid, route, params));
     let (mut tracks, tails) = track::track_edges_with_tails(&input, grid, &seeds, params);
     shadow::place_shadowed_toes(&input, grid, &mut tracks, params);
     let tracks = postfilter::remove_short(&input, tracks, params);
