@@ -68,9 +68,12 @@ fn stepped_ground(
     if z.len() < 8 {
         return None;
     }
-    z.sort_unstable_by(f64::total_cmp);
-    let at = |q: f64| z[((z.len() - 1) as f64 * q).round() as usize];
-    (at(0.95) - at(0.05) >= 0.5 * params.profile_min_step_m).then(|| at(0.5))
+    let mut at = |q: f64| {
+        let k = ((z.len() - 1) as f64 * q).round() as usize;
+        *z.select_nth_unstable_by(k, f64::total_cmp).1
+    };
+    let (low, high) = (at(0.05), at(0.95));
+    (high - low >= 0.5 * params.profile_min_step_m).then(|| at(0.5))
 }
 
 /// Seeds on legs (see the module docs), in interval order, left before right.
