@@ -17,10 +17,11 @@
 use rayon::prelude::*;
 
 use super::grid::PointGrid;
+use super::leg_screen::HeightRaster;
 use super::params::BendParams;
 use super::profile::{usable, Profile};
 use super::route::Route;
-use super::seed::{nearest_usable, Seed};
+use super::seed::{finite_range, nearest_usable, Seed};
 use super::BendInput;
 use crate::model::Side;
 
@@ -42,10 +43,39 @@ const LEG_STEP_ASIDE_M: f64 = 1.5;
 /// leave no leg crossing the line unseen.
 const LEG_STEP_ALONG_M: f64 = 0.5;
 
-/// Turns of the profiles' length from the route's normal that are tried, degrees, in
-/// order: side streets meet the road at angles other than right ones, and a profile 0.6 m
-/// long sees a toe only on a curb within about 10° of its length.
-const LEG_TURNS_DEG: [f64; 5] = [0.0, 20.0, -20.0, 40.0, -40.0];
+/// Turns of the profiles' length from the curb's direction that the raster's rise gives,
+/// degrees, in order: that direction comes from cells half a metre wide, and a profile
+/// 0.6 m long sees a toe only on a curb within about 10° of its length.
+const LEG_TURNS_DEG: [f64; 3] = [0.0, 15.0, -15.0];
+
+/// Least step in the ground's mean height along the route ([`HeightRaster::step_along`])
+/// where the profiles are tried, as a share of the least curb step: the cells either side
+/// of a toe hold parts of the step's two levels.
+const SCREEN_MIN_SHARE: f64 = 0.4;
+
+/// Greatest such step, metres: more is a wall, a vehicle or a drop, not a curb.
+const SCREEN_MAX_M: f64 = 0.4;
+
+/// The [`HeightRaster`] over the band of the route from arc length `s0` to `s1` and
+/// [`LEG_REACH_M`] (and the screen's reach) either side.
+fn band_raster(input: &BendInput, route: &Route, s0: f64, s1: f64) -> Option<HeightRaster> {
+    let margin = LEG_REACH_M + 4.0 * super::leg_screen::CELL_M;
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    let mut s = s0;
+    loop {
+        if let Some((p, _)) = route.pose_at_arc(s.min(s1)) {
+            for k in 0..2 {
+                lo[k] = lo[k].min(p[k] - margin);
+                hi[k] = hi[k].max(p[k] + margin);
+            }
+        }
+        if s >= s1 {
+            break;
+        }
+        s += 1.0;
+    }
+    HeightRaster::build(input, lo, hi)
+}
 
 /// The ground height at `centre` for a leg's profile: the median height of the usable
 /// points within the profile's half-width, `None` with fewer than 8 of them or where
@@ -92,8 +122,7 @@ pub fn leg_seeds(
     params: &BendParams,
 ) -> Vec<Seed> {
     let reach = LEG_REACH_M;
-    let finite_t = || input.t.iter().copied().filter(|t| t.is_finite());
-    let (Some(t0), Some(t1)) = (finite_t().reduce(f64::min), finite_t().reduce(f64::max)) else {
+    let Some((t0, t1)) = finite_range(input.t) else {
         return Vec::new();
     };
     let (Some(s0), Some(s1)) = (route.arc_at(t0), route.arc_at(t1)) else {
@@ -103,6 +132,10 @@ pub fn leg_seeds(
     let half_l = 2.0 * params.profile_half_length_m;
     let per_interval = (l_s / LEG_STEP_ALONG_M).ceil().max(1.0) as usize;
     let intervals: Vec<i64> = ((s0 / l_s).floor() as i64..=(s1 / l_s).floor() as i64).collect();
+    let Some(raster) = band_raster(input, route, s0, s1) else {
+        return Vec::new();
+    };
+    let min_rise = SCREEN_MIN_SHARE * params.profile_min_step_m;
     let sides = [(Side::Left, 1.0), (Side::Right, -1.0)];
     let mut out: Vec<Seed> = intervals
         .par_iter()
@@ -125,22 +158,34 @@ pub fn leg_seeds(
                 let found = poses.iter().find_map(|&(p, fwd)| {
                     let n = [-fwd[1] * sign, fwd[0] * sign];
                     let centre = [p[0] + c * n[0], p[1] + c * n[1]];
+                    let rise = raster.step_along(centre, fwd)?;
+                    if !(min_rise..=SCREEN_MAX_M).contains(&rise.abs()) {
+                        return None;
+                    }
+                    // A curb within half a right angle of the normal rises more along
+                    // the route than across it; its direction is across the rise.
+                    let rise_n = raster.step_along(centre, n).unwrap_or(0.0);
+                    if rise_n.abs() > rise.abs() {
+                        return None;
+                    }
+                    let g = [rise * fwd[0] + rise_n * n[0], rise * fwd[1] + rise_n * n[1]];
+                    let norm = g[0].hypot(g[1]);
+                    let curb = [-g[1] / norm, g[0] / norm];
                     let ground = stepped_ground(input, grid, centre, params, &mut z)?;
                     let toe = LEG_TURNS_DEG.iter().find_map(|&turn| {
                         let (sin, cos) = f64::to_radians(turn).sin_cos();
-                        let along = [n[0] * cos - n[1] * sin, n[0] * sin + n[1] * cos];
-                        [1.0, -1.0].into_iter().find_map(|up| {
-                            Profile {
-                                input,
-                                grid,
-                                params,
-                                centre: [centre[0], centre[1], ground],
-                                along,
-                                up,
-                                half_l,
-                            }
-                            .toe()
-                        })
+                        let along = [curb[0] * cos - curb[1] * sin, curb[0] * sin + curb[1] * cos];
+                        // The curb side lies right of `along`, up the rise.
+                        Profile {
+                            input,
+                            grid,
+                            params,
+                            centre: [centre[0], centre[1], ground],
+                            along,
+                            up: -1.0,
+                            half_l,
+                        }
+                        .toe()
                     })?;
                     nearest_usable(input, grid, toe.xyz, params.search_radius_m)
                         .map(|point| (point, n))

@@ -21,6 +21,7 @@ pub mod flush;
 pub mod grid;
 pub mod hole;
 pub mod leg;
+pub mod leg_screen;
 pub mod leg_seed;
 pub mod params;
 pub mod postfilter;

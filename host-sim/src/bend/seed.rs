@@ -204,7 +204,7 @@ pub fn profile_seeds(
 }
 
 /// The smallest and the largest finite value of `t`, `None` where none is finite.
-fn finite_range(t: &[f64]) -> Option<(f64, f64)> {
+pub(super) fn finite_range(t: &[f64]) -> Option<(f64, f64)> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for &v in t {
         if v.is_finite() {
