@@ -1,18 +1,20 @@
-//! Seeds on side streets' legs: virtual profiles laid along the route's normal, so that
-//! they cross a curb that runs away from the route.
+//! Seeds on side streets' legs: virtual profiles laid along a curb that runs away from
+//! the route, where a coarse raster of the ground's height shows such a curb.
 //!
 //! The core's candidates come from bend angles along the scanlines, and a scanline that
 //! runs beside a side street's curb bends nowhere at its toe; the profile seeds
 //! ([`super::seed::profile_seeds`]) are profiles across the driving direction, which see a
 //! curb parallel to the route and not one at a large angle to it. A leg left unseeded is
 //! never tracked, unless a track comes round its corner and follows it all the way. Here,
-//! on lines parallel to the route at a few distances aside, profiles whose own length runs
-//! along the route's normal (their step across runs along the route, either way up) look
-//! for the leg's toe; the first toe found at each distance gives a seed, so a leg that a
-//! track leaves at a hole in the returns is seeded again beyond it. Only the stretch of
-//! route the input's points cover is searched (a streaming window seeds its own stretch),
-//! and the seeds come last in tracking, after the profile seeds: they start tracks only
-//! where no other track has claimed the curb.
+//! on lines parallel to the route at a few distances aside, the raster
+//! ([`super::leg_screen`]) tells where the ground rises along the route by about a curb
+//! and more than it rises across it (a curb within half a right angle of the normal); only
+//! there does a profile look for the leg's toe, its length along the curb's direction that
+//! the rise gives and its curb side up the rise. The first toe found at each distance gives
+//! a seed, so a leg that a track leaves at a hole in the returns is seeded again beyond it.
+//! Only the stretch of route the input's points cover is searched (a streaming window
+//! seeds its own stretch), and the seeds come last in tracking, after the profile seeds:
+//! they start tracks only where no other track has claimed the curb.
 
 use rayon::prelude::*;
 
@@ -108,13 +110,15 @@ fn stepped_ground(
 
 /// Seeds on legs (see the module docs), in interval order, left before right.
 ///
-/// For each interval of L_s along the route and each side, profiles centred on the ground
-/// (the median height within the profile's half-width) at [`LEG_STEP_ALONG_M`] along the
-/// interval and [`LEG_STEP_ASIDE_M`] aside from [`LEG_NEAR_M`] to [`LEG_REACH_M`]
-/// are tried, turned by [`LEG_TURNS_DEG`], with the step rising either way (`Profile::toe`),
-/// where the ground there shows a step ([`stepped_ground`]); the first
-/// toe on a line gives a seed on the usable point nearest to it, its direction the route's
-/// normal, inlier share 0.
+/// For each interval of L_s along the route and each side, at [`LEG_STEP_ALONG_M`] along
+/// the interval and [`LEG_STEP_ASIDE_M`] aside from [`LEG_NEAR_M`] to [`LEG_REACH_M`],
+/// where the raster's rise along the route lies between [`SCREEN_MIN_SHARE`] of the least
+/// curb step and [`SCREEN_MAX_M`] and exceeds the rise along the normal, and where the
+/// points there show a step ([`stepped_ground`]), profiles centred on the ground (the
+/// median height within the profile's half-width) along the curb's direction that the two
+/// rises give, turned by [`LEG_TURNS_DEG`], the curb side up the rise, are tried
+/// (`Profile::toe`); the first toe on a line gives a seed on the usable point nearest to
+/// it, its direction the route's normal, inlier share 0.
 pub fn leg_seeds(
     input: &BendInput,
     grid: &PointGrid,
