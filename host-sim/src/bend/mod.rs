@@ -21,6 +21,8 @@ pub mod flush;
 pub mod grid;
 pub mod hole;
 pub mod leg;
+pub mod leg_screen;
+pub mod leg_seed;
 pub mod params;
 pub mod postfilter;
 pub mod profile;
@@ -179,6 +181,9 @@ pub fn extract_edges_on_grid(
             .then(a.interval.cmp(&b.interval))
             .then(a.point.cmp(&b.point))
     });
+    // Seeds on side streets' legs come after all others: they start tracks only on curbs
+    // that no other seed's track reaches.
+    seeds.extend(leg_seed::leg_seeds(&input, grid, route, params));
     let (mut tracks, tails) = track::track_edges_with_tails(&input, grid, &seeds, params);
     shadow::place_shadowed_toes(&input, grid, &mut tracks, params);
     let tracks = postfilter::remove_short(&input, tracks, params);

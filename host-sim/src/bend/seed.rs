@@ -204,7 +204,7 @@ pub fn profile_seeds(
 }
 
 /// The smallest and the largest finite value of `t`, `None` where none is finite.
-fn finite_range(t: &[f64]) -> Option<(f64, f64)> {
+pub(super) fn finite_range(t: &[f64]) -> Option<(f64, f64)> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for &v in t {
         if v.is_finite() {
@@ -440,7 +440,12 @@ fn from_total_order(k: i64) -> f64 {
 }
 
 /// The usable point nearest (horizontally) to `at` within `r`, lowest index on ties.
-fn nearest_usable(input: &BendInput, grid: &PointGrid, at: [f64; 3], r: f64) -> Option<u32> {
+pub(super) fn nearest_usable(
+    input: &BendInput,
+    grid: &PointGrid,
+    at: [f64; 3],
+    r: f64,
+) -> Option<u32> {
     let mut best: Option<(f64, usize)> = None;
     grid.for_each_within(input.x, input.y, at[0], at[1], r, |i| {
         if !usable(input, i) {
