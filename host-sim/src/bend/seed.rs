@@ -14,7 +14,7 @@ use super::arc_seed::{arc_params, arc_seed};
 use super::face::face_toe_or_longer;
 use super::grid::PointGrid;
 use super::params::{widened, BendParams};
-use super::profile::{usable, Profile};
+use super::profile::{usable, Profile, ProfileToe};
 use super::route::Route;
 use super::BendInput;
 use crate::model::Side;
@@ -125,6 +125,11 @@ const SPARSE_LENGTH_FACTOR: f64 = 2.0;
 /// side (the tracker's `profile::Profile::toe_or_longer` does the same). Short stretches
 /// of curb seen between parked vehicles are then seeded as well.
 ///
+/// Where none finds a toe, the three searches are made again with the points on the curb's
+/// face left out (`profile::Profile::toe_past_face`): on a far curb the returns lie a
+/// decimetre or two apart across, and one on the face, half-way up the step, tilts the
+/// road's or the top's line so that no profile shows the curb.
+///
 /// Where none finds a toe either, profiles turned towards a corner arc's direction are
 /// tried ([`arc_seed`]): an arc whose curb before it is never seen is reached by no track.
 ///
@@ -172,12 +177,10 @@ pub fn profile_seeds(
             .filter_map(|((interval, p, fwd), (side, up))| {
                 let n = [-fwd[1] * up, fwd[0] * up];
                 let mut heights = Heights::new(params.profile_half_width_m);
-                let mut first = |params: &BendParams, half_l: f64, along: [f64; 2]| {
+                let mut first = |params: &BendParams, half_l: f64, along: [f64; 2], toe: ToeOn| {
                     let h = &mut heights;
                     let range = (PROFILE_SEED_NEAR_M, reach);
-                    first_toe_outward(
-                        input, grid, p, along, n, up, half_l, range, false, params, h,
-                    )
+                    first_toe_outward(input, grid, p, along, n, up, half_l, range, toe, params, h)
                 };
                 let seed = |point| Seed {
                     point,
@@ -186,17 +189,23 @@ pub fn profile_seeds(
                     interval,
                     inlier_ratio: 0.0,
                 };
-                first(params, half_l, fwd)
-                    .or_else(|| first(&wide, half_l, fwd))
-                    .or_else(|| first(params, SPARSE_LENGTH_FACTOR * half_l, fwd))
+                let toe: ToeOn = |profile| profile.toe();
+                let past_face: ToeOn = |profile| profile.toe_past_face();
+                let long = SPARSE_LENGTH_FACTOR * half_l;
+                first(params, half_l, fwd, toe)
+                    .or_else(|| first(&wide, half_l, fwd, toe))
+                    .or_else(|| first(params, long, fwd, toe))
+                    .or_else(|| first(params, half_l, fwd, past_face))
+                    .or_else(|| first(&wide, half_l, fwd, past_face))
+                    .or_else(|| first(params, long, fwd, past_face))
                     .map(seed)
                     .or_else(|| {
-                        arc_seed(fwd, |along| first(&arc, half_l, along)).map(|(point, along)| {
-                            Seed {
+                        arc_seed(fwd, |along| first(&arc, half_l, along, toe)).map(
+                            |(point, along)| Seed {
                                 dir: along,
                                 ..seed(point)
-                            }
-                        })
+                            },
+                        )
                     })
             }),
     );
@@ -255,9 +264,12 @@ impl Heights {
     }
 }
 
+/// A toe search on one profile ([`Profile::toe`] and its fallbacks).
+type ToeOn = fn(&Profile) -> Option<ProfileToe>;
+
 /// The seed point of the first toe that profiles across `fwd` find outward along `n` from
 /// `p`, from `near` to `reach` every [`PROFILE_SEED_STEP_M`] (see [`profile_seeds`]), by
-/// `profile::Profile::toe`, else `face::face_toe_or_longer` when `ring`: the usable point nearest to it;
+/// `toe_on` on each profile: the usable point nearest to it;
 /// `None` where the first toe has none within the search radius, or there is no toe. The
 /// ground heights come from `heights`.
 #[allow(clippy::too_many_arguments)]
@@ -270,7 +282,7 @@ fn first_toe_outward(
     up: f64,
     half_l: f64,
     (near, reach): (f64, f64),
-    ring: bool,
+    toe_on: ToeOn,
     params: &BendParams,
     heights: &mut Heights,
 ) -> Option<u32> {
@@ -293,12 +305,7 @@ fn first_toe_outward(
             up,
             half_l,
         };
-        let toe = if ring {
-            profile.toe().or_else(|| face_toe_or_longer(&profile))
-        } else {
-            profile.toe()
-        };
-        let Some(toe) = toe else {
+        let Some(toe) = toe_on(&profile) else {
             continue;
         };
         return nearest_usable(input, grid, toe.xyz, params.search_radius_m);
@@ -366,8 +373,9 @@ pub fn end_seeds(
             let along = [ray[1], -ray[0]];
             let range = (view.near_m, view.reach_m);
             let h = &mut Heights::new(params.profile_half_width_m);
+            let toe: ToeOn = |profile| profile.toe().or_else(|| face_toe_or_longer(profile));
             let point = first_toe_outward(
-                input, grid, p, along, ray, 1.0, half_l, range, true, params, h,
+                input, grid, p, along, ray, 1.0, half_l, range, toe, params, h,
             )?;
             let i = point as usize;
             let (dx, dy) = (input.x[i] - p[0], input.y[i] - p[1]);
@@ -700,7 +708,7 @@ mod tests {
                     1.0,
                     half_l,
                     (PROFILE_SEED_NEAR_M, 15.0),
-                    false,
+                    |profile| profile.toe(),
                     p,
                     &mut Heights::new(params.profile_half_width_m),
                 );
@@ -767,7 +775,7 @@ mod tests {
                     1.0,
                     l,
                     (PROFILE_SEED_NEAR_M, 15.0),
-                    false,
+                    |profile| profile.toe(),
                     p,
                     &mut Heights::new(params.profile_half_width_m),
                 );
