@@ -176,7 +176,7 @@ pub fn profile_seeds(
             .flat_map_iter(|&l| sides.iter().map(move |&s| (l, s)))
             .filter_map(|((interval, p, fwd), (side, up))| {
                 let n = [-fwd[1] * up, fwd[0] * up];
-                let mut heights = Heights::new(params.profile_half_width_m);
+                let mut heights = Heights::default();
                 let mut first = |params: &BendParams, half_l: f64, along: [f64; 2], toe: ToeOn| {
                     let h = &mut heights;
                     let range = (PROFILE_SEED_NEAR_M, reach);
@@ -225,26 +225,18 @@ fn finite_range(t: &[f64]) -> Option<(f64, f64)> {
 }
 
 /// The ground heights ([`ground_height`]) at the centres of one side's outward search,
-/// kept for the searches after it: the centres are the same in every search, and the
-/// profiles of the default width and the longer ones take their heights over the same
-/// radius (`r`); a search of another radius (the widened profiles') computes its own.
+/// kept for the searches after it: the centres are the same in every search, and each
+/// radius (the default profiles' and the longer ones', the widened ones', the turned ones')
+/// has its own heights.
+#[derive(Default)]
 struct Heights {
-    r: f64,
-    /// By centre, counted outward: `None` where not yet computed.
-    z: Vec<Option<Option<f64>>>,
+    /// By radius (its bits), then by centre counted outward: `None` where not yet computed.
+    z: Vec<(u64, Vec<Option<Option<f64>>>)>,
     /// The heights within the radius, kept from one centre to the next.
     scratch: Vec<i64>,
 }
 
 impl Heights {
-    fn new(r: f64) -> Self {
-        Self {
-            r,
-            z: Vec::new(),
-            scratch: Vec::new(),
-        }
-    }
-
     /// [`ground_height`] at centre `k` (counted outward) within `r` of `centre`.
     fn at(
         &mut self,
@@ -254,13 +246,19 @@ impl Heights {
         centre: [f64; 2],
         r: f64,
     ) -> Option<f64> {
-        if r.to_bits() != self.r.to_bits() {
-            return ground_height(input, grid, centre, r, &mut self.scratch);
+        let bits = r.to_bits();
+        let slot = match self.z.iter().position(|s| s.0 == bits) {
+            Some(slot) => slot,
+            None => {
+                self.z.push((bits, Vec::new()));
+                self.z.len() - 1
+            }
+        };
+        let (z, scratch) = (&mut self.z[slot].1, &mut self.scratch);
+        if z.len() <= k {
+            z.resize(k + 1, None);
         }
-        if self.z.len() <= k {
-            self.z.resize(k + 1, None);
-        }
-        *self.z[k].get_or_insert_with(|| ground_height(input, grid, centre, r, &mut self.scratch))
+        *z[k].get_or_insert_with(|| ground_height(input, grid, centre, r, scratch))
     }
 }
 
@@ -372,7 +370,7 @@ pub fn end_seeds(
             // Across the profile runs along the ray, away from the sensor (`up` = +1).
             let along = [ray[1], -ray[0]];
             let range = (view.near_m, view.reach_m);
-            let h = &mut Heights::new(params.profile_half_width_m);
+            let h = &mut Heights::default();
             let toe: ToeOn = |profile| profile.toe().or_else(|| face_toe_or_longer(profile));
             let point = first_toe_outward(
                 input, grid, p, along, ray, 1.0, half_l, range, toe, params, h,
@@ -710,7 +708,7 @@ mod tests {
                     (PROFILE_SEED_NEAR_M, 15.0),
                     |profile| profile.toe(),
                     p,
-                    &mut Heights::new(params.profile_half_width_m),
+                    &mut Heights::default(),
                 );
                 assert_eq!(toe, None, "a toe at {at:?}");
             }
@@ -777,7 +775,7 @@ mod tests {
                     (PROFILE_SEED_NEAR_M, 15.0),
                     |profile| profile.toe(),
                     p,
-                    &mut Heights::new(params.profile_half_width_m),
+                    &mut Heights::default(),
                 );
                 assert_eq!(toe, None, "a toe at {at:?}");
             }
