@@ -148,8 +148,8 @@ impl Profile<'_> {
         any && all
     }
 
-    /// The toe on the profile without the points that lie on the curb's face, for where
-    /// [`Profile::toe`] finds none.
+    /// [`Profile::toe`], and where it finds none, the toe on the profile without the points
+    /// that lie on the curb's face (second), gathered once.
     ///
     /// Far from the scanner the returns lie a decimetre or two apart across, and where one
     /// of them falls on the face (or the chamfer at its top) half-way up the step, it
@@ -160,11 +160,22 @@ impl Profile<'_> {
     /// (between the two parts' median heights) from both levels are left out, and
     /// [`Profile::toe`]'s search is made on the rest with all of its tests. A ramp (a curb
     /// cut's) leaves more than [`SPLIT_NEAR_M`] of points between the levels and still
-    /// fails them. `None` where no point lies on the face (the search would be
-    /// [`Profile::toe`]'s).
-    pub fn toe_past_face(&self) -> Option<ProfileToe> {
+    /// fails them. The second is `None` where no point lies on the face (the search would
+    /// be [`Profile::toe`]'s).
+    pub fn toe_or_past_face(&self) -> (Option<ProfileToe>, Option<ProfileToe>) {
         let prof = self.gather();
-        let k = level_split(&prof, &Sums::new(&prof))?;
+        match self.split_points(&prof) {
+            Some(s) => (Some(s.toe), None),
+            None => (None, self.past_face(&prof)),
+        }
+    }
+
+    /// [`Profile::toe_or_past_face`]'s second toe on the profile's points `prof`.
+    fn past_face(&self, prof: &[(f64, f64, f64)]) -> Option<ProfileToe> {
+        if prof.len() < 2 * SPLIT_MIN_SIDE {
+            return None;
+        }
+        let k = level_split(prof, &Sums::new(prof))?;
         let toe = 0.5 * (prof[k - 1].0 + prof[k].0);
         let mut low: Vec<f64> = prof[..k].iter().map(|p| p.1).collect();
         let mut high: Vec<f64> = prof[k..].iter().map(|p| p.1).collect();
@@ -623,7 +634,7 @@ mod tests {
         assert!(toe_beside(|x| -0.2 * x, &params).is_none());
     }
 
-    /// [`Profile::toe`] and [`Profile::toe_past_face`] on a profile across a curb along y
+    /// [`Profile::toe_or_past_face`] on a profile across a curb along y
     /// (towards +x), its returns in columns across at `(x, z)`, five along each (every
     /// 0.12 m), as a far curb's returns lie.
     fn columns(cols: &[(f64, f64)]) -> (Option<ProfileToe>, Option<ProfileToe>) {
@@ -649,7 +660,7 @@ mod tests {
             up: -1.0,
             half_l: 0.3,
         };
-        (profile.toe(), profile.toe_past_face())
+        profile.toe_or_past_face()
     }
 
     #[test]
@@ -668,7 +679,7 @@ mod tests {
         let past = past.expect("a toe past the face");
         assert!(past.xyz[0].abs() < 0.1, "{past:?}");
         assert!((past.step_m - 0.08).abs() < 0.02, "{past:?}");
-        // The same curb without the face's column: `toe` finds it, and nothing is left out.
+        // The same curb without the face's column: `toe` finds it.
         let plain: Vec<(f64, f64)> = face.iter().copied().filter(|c| c.1 != 0.03).collect();
         let (toe, past) = columns(&plain);
         assert!(toe.is_some() && past.is_none(), "{toe:?} {past:?}");

@@ -125,10 +125,11 @@ const SPARSE_LENGTH_FACTOR: f64 = 2.0;
 /// side (the tracker's `profile::Profile::toe_or_longer` does the same). Short stretches
 /// of curb seen between parked vehicles are then seeded as well.
 ///
-/// Where none finds a toe, the three searches are made again with the points on the curb's
-/// face left out (`profile::Profile::toe_past_face`): on a far curb the returns lie a
-/// decimetre or two apart across, and one on the face, half-way up the step, tilts the
-/// road's or the top's line so that no profile shows the curb.
+/// Where none finds a toe, the first toe the three searches find with the points on the
+/// curb's face left out (`profile::Profile::toe_or_past_face`, on the points each profile
+/// gathered) gives the seed: on a far curb the returns lie a decimetre or two apart
+/// across, and one on the face, half-way up the step, tilts the road's or the top's line
+/// so that no profile shows the curb.
 ///
 /// Where none finds a toe either, profiles turned towards a corner arc's direction are
 /// tried ([`arc_seed`]): an arc whose curb before it is never seen is reached by no track.
@@ -189,24 +190,28 @@ pub fn profile_seeds(
                     interval,
                     inlier_ratio: 0.0,
                 };
-                let toe: ToeOn = |profile| profile.toe();
-                let past_face: ToeOn = |profile| profile.toe_past_face();
+                // The default, widened and longer searches in turn; the first toe past a
+                // face (in the same order) where none finds a toe.
+                let past_face: ToeOn = |profile| profile.toe_or_past_face();
                 let long = SPARSE_LENGTH_FACTOR * half_l;
-                first(params, half_l, fwd, toe)
-                    .or_else(|| first(&wide, half_l, fwd, toe))
-                    .or_else(|| first(params, long, fwd, toe))
-                    .or_else(|| first(params, half_l, fwd, past_face))
-                    .or_else(|| first(&wide, half_l, fwd, past_face))
-                    .or_else(|| first(params, long, fwd, past_face))
-                    .map(seed)
-                    .or_else(|| {
-                        arc_seed(fwd, |along| first(&arc, half_l, along, toe)).map(
-                            |(point, along)| Seed {
-                                dir: along,
-                                ..seed(point)
-                            },
-                        )
-                    })
+                let (mut found, mut face) = (None, None);
+                for (params, half_l) in [(params, half_l), (&wide, half_l), (params, long)] {
+                    let (toe, past) = first(params, half_l, fwd, past_face);
+                    if toe.is_some() {
+                        found = toe;
+                        break;
+                    }
+                    face = face.or(past);
+                }
+                let toe: ToeOn = |profile| (profile.toe(), None);
+                found.or(face).map(seed).or_else(|| {
+                    arc_seed(fwd, |along| first(&arc, half_l, along, toe).0).map(
+                        |(point, along)| Seed {
+                            dir: along,
+                            ..seed(point)
+                        },
+                    )
+                })
             }),
     );
     out
@@ -262,14 +267,15 @@ impl Heights {
     }
 }
 
-/// A toe search on one profile ([`Profile::toe`] and its fallbacks).
-type ToeOn = fn(&Profile) -> Option<ProfileToe>;
+/// A toe search on one profile: its toe, else a fallback toe of a lower rank (one found
+/// past the curb's face).
+type ToeOn = fn(&Profile) -> (Option<ProfileToe>, Option<ProfileToe>);
 
 /// The seed point of the first toe that profiles across `fwd` find outward along `n` from
 /// `p`, from `near` to `reach` every [`PROFILE_SEED_STEP_M`] (see [`profile_seeds`]), by
-/// `toe_on` on each profile: the usable point nearest to it;
-/// `None` where the first toe has none within the search radius, or there is no toe. The
-/// ground heights come from `heights`.
+/// `toe_on` on each profile: the usable point nearest to it, `None` where the first toe has
+/// none within the search radius, or there is no toe; and where there is no toe, the seed
+/// point of the first fallback toe the same way. The ground heights come from `heights`.
 #[allow(clippy::too_many_arguments)]
 fn first_toe_outward(
     input: &BendInput,
@@ -283,7 +289,8 @@ fn first_toe_outward(
     toe_on: ToeOn,
     params: &BendParams,
     heights: &mut Heights,
-) -> Option<u32> {
+) -> (Option<u32>, Option<u32>) {
+    let mut fallback = None;
     let mut c = near;
     let mut k = 0;
     while c <= reach {
@@ -303,12 +310,15 @@ fn first_toe_outward(
             up,
             half_l,
         };
-        let Some(toe) = toe_on(&profile) else {
-            continue;
-        };
-        return nearest_usable(input, grid, toe.xyz, params.search_radius_m);
+        let (toe, past) = toe_on(&profile);
+        if let Some(toe) = toe {
+            let point = nearest_usable(input, grid, toe.xyz, params.search_radius_m);
+            return (point, None);
+        }
+        fallback = fallback.or(past);
     }
-    None
+    let point = fallback.and_then(|t| nearest_usable(input, grid, t.xyz, params.search_radius_m));
+    (None, point)
 }
 
 /// Seeds from radial profiles at the two ends of the input's points, for a spinning
@@ -371,10 +381,12 @@ pub fn end_seeds(
             let along = [ray[1], -ray[0]];
             let range = (view.near_m, view.reach_m);
             let h = &mut Heights::default();
-            let toe: ToeOn = |profile| profile.toe().or_else(|| face_toe_or_longer(profile));
+            let toe: ToeOn =
+                |profile| (profile.toe().or_else(|| face_toe_or_longer(profile)), None);
             let point = first_toe_outward(
                 input, grid, p, along, ray, 1.0, half_l, range, toe, params, h,
-            )?;
+            )
+            .0?;
             let i = point as usize;
             let (dx, dy) = (input.x[i] - p[0], input.y[i] - p[1]);
             let side = if fwd[0] * dy - fwd[1] * dx >= 0.0 {
@@ -706,10 +718,11 @@ mod tests {
                     1.0,
                     half_l,
                     (PROFILE_SEED_NEAR_M, 15.0),
-                    |profile| profile.toe(),
+                    |profile| (profile.toe(), None),
                     p,
                     &mut Heights::default(),
-                );
+                )
+                .0;
                 assert_eq!(toe, None, "a toe at {at:?}");
             }
         }
@@ -773,10 +786,11 @@ mod tests {
                     1.0,
                     l,
                     (PROFILE_SEED_NEAR_M, 15.0),
-                    |profile| profile.toe(),
+                    |profile| (profile.toe(), None),
                     p,
                     &mut Heights::default(),
-                );
+                )
+                .0;
                 assert_eq!(toe, None, "a toe at {at:?}");
             }
         }
