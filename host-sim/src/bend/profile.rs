@@ -3,7 +3,7 @@
 
 use super::grid::PointGrid;
 use super::params::BendParams;
-use super::{median, BendInput};
+use super::BendInput;
 use crate::replay::PointStatus;
 
 /// Points a virtual profile may use: kept by the core, with or without a bend angle.
@@ -177,19 +177,19 @@ impl Profile<'_> {
         }
         let k = level_split(prof, &Sums::new(prof))?;
         let toe = 0.5 * (prof[k - 1].0 + prof[k].0);
-        let mut low: Vec<f64> = prof[..k].iter().map(|p| p.1).collect();
-        let mut high: Vec<f64> = prof[k..].iter().map(|p| p.1).collect();
-        let (zl, zh) = (median(&mut low)?, median(&mut high)?);
+        let mut z: Vec<f64> = prof.iter().map(|p| p.1).collect();
+        let (low, high) = z.split_at_mut(k);
+        let (zl, zh) = (select_median(low)?, select_median(high)?);
         if zh - zl < self.params.profile_min_step_m {
             return None;
         }
         let q = 0.25 * (zh - zl);
         let on_face =
             |p: &(f64, f64, f64)| (p.0 - toe).abs() <= SPLIT_NEAR_M && p.1 > zl + q && p.1 < zh - q;
-        let rest: Vec<(f64, f64, f64)> = prof.iter().filter(|p| !on_face(p)).copied().collect();
-        if rest.len() == prof.len() {
+        if !prof.iter().any(on_face) {
             return None;
         }
+        let rest: Vec<(f64, f64, f64)> = prof.iter().filter(|p| !on_face(p)).copied().collect();
         self.split_points(&rest).map(|s| s.toe)
     }
 
@@ -270,6 +270,23 @@ impl Profile<'_> {
             first_high: prof[k].0,
         })
     }
+}
+
+/// The median of `v` as [`super::median`] gives it, by selection rather than a sort (`v` is
+/// reordered); `None` when empty.
+fn select_median(v: &mut [f64]) -> Option<f64> {
+    let (n, m) = (v.len(), v.len() / 2);
+    if n == 0 {
+        return None;
+    }
+    let (lower, mid, _) = v.select_nth_unstable_by(m, |a, b| a.total_cmp(b));
+    let mid = *mid;
+    Some(if n % 2 == 1 {
+        mid
+    } else {
+        let below = lower.iter().copied().max_by(|a, b| a.total_cmp(b))?;
+        0.5 * (below + mid)
+    })
 }
 
 /// Fewest points on each side of [`Profile::toe`]'s split.
