@@ -148,43 +148,70 @@ impl Profile<'_> {
         any && all
     }
 
-    /// [`Profile::toe`]'s search, with the offsets it split the profile at.
-    fn split(&self) -> Option<Split> {
-        let params = self.params;
-        let half_w = params.profile_half_width_m;
-        const MIN_SIDE: usize = 4;
+    /// [`Profile::toe`], and where it finds none, the toe on the profile without the points
+    /// that lie on the curb's face (second), gathered once.
+    ///
+    /// Far from the scanner the returns lie a decimetre or two apart across, and where one
+    /// of them falls on the face (or the chamfer at its top) half-way up the step, it
+    /// belongs to neither level: joined to the road it tilts the road's line, joined to the
+    /// curb it tilts the top's or shrinks the step, and [`Profile::toe`] sees no curb on a
+    /// profile that shows one. Here the profile is split in two levels as there; the points
+    /// within [`SPLIT_NEAR_M`] of that split whose heights lie more than a quarter of the step
+    /// (between the two parts' median heights) from both levels are left out, and
+    /// [`Profile::toe`]'s search is made on the rest with all of its tests. A ramp (a curb
+    /// cut's) leaves more than [`SPLIT_NEAR_M`] of points between the levels and still
+    /// fails them. The second is `None` where no point lies on the face (the search would
+    /// be [`Profile::toe`]'s).
+    pub fn toe_or_past_face(&self) -> (Option<ProfileToe>, Option<ProfileToe>) {
         let prof = self.gather();
-        if prof.len() < 2 * MIN_SIDE {
+        match self.split_points(&prof) {
+            Some(s) => (Some(s.toe), None),
+            None => (None, self.past_face(&prof)),
+        }
+    }
+
+    /// [`Profile::toe_or_past_face`]'s second toe on the profile's points `prof`.
+    fn past_face(&self, prof: &[(f64, f64, f64)]) -> Option<ProfileToe> {
+        if prof.len() < 2 * SPLIT_MIN_SIDE {
             return None;
         }
-        let m = prof.len();
-        let sums = Sums::new(&prof);
-        let line = |lo: usize, hi: usize| sums.line(lo, hi);
-        let acc = &sums.acc;
-        // Σ(z − mean)² over prof[lo..hi].
-        let level_sse = |lo: usize, hi: usize| {
-            let (n, sz, szz) = (
-                (hi - lo) as f64,
-                acc[hi][3] - acc[lo][3],
-                acc[hi][5] - acc[lo][5],
-            );
-            (szz - sz * sz / n).max(0.0)
-        };
-        // Best split k: prof[..k] road, prof[k..] curb, each part one level. Points on the curb
-        // face go to the nearer level, so the split falls at the face's middle.
-        let mut best: Option<(f64, usize)> = None;
-        for k in MIN_SIDE..=m - MIN_SIDE {
-            if prof[k].0 - prof[k - 1].0 <= 0.0 {
-                continue; // a split must fall between two distinct positions
-            }
-            let e = level_sse(0, k) + level_sse(k, m);
-            if best.is_none_or(|(be, _)| e < be) {
-                best = Some((e, k));
-            }
-        }
-        let (_, k) = best?;
+        let k = level_split(prof, &Sums::new(prof))?;
         let toe = 0.5 * (prof[k - 1].0 + prof[k].0);
-        const NEAR_M: f64 = 0.15;
+        let mut z: Vec<f64> = prof.iter().map(|p| p.1).collect();
+        let (low, high) = z.split_at_mut(k);
+        let (zl, zh) = (select_median(low)?, select_median(high)?);
+        if zh - zl < self.params.profile_min_step_m {
+            return None;
+        }
+        let q = 0.25 * (zh - zl);
+        let on_face =
+            |p: &(f64, f64, f64)| (p.0 - toe).abs() <= SPLIT_NEAR_M && p.1 > zl + q && p.1 < zh - q;
+        if !prof.iter().any(on_face) {
+            return None;
+        }
+        let rest: Vec<(f64, f64, f64)> = prof.iter().filter(|p| !on_face(p)).copied().collect();
+        self.split_points(&rest).map(|s| s.toe)
+    }
+
+    /// [`Profile::toe`]'s search, with the offsets it split the profile at.
+    fn split(&self) -> Option<Split> {
+        self.split_points(&self.gather())
+    }
+
+    /// [`Profile::split`] on the points `prof` (across, z, along), sorted by `across`.
+    fn split_points(&self, prof: &[(f64, f64, f64)]) -> Option<Split> {
+        let params = self.params;
+        let half_w = params.profile_half_width_m;
+        const MIN_SIDE: usize = SPLIT_MIN_SIDE;
+        let m = prof.len();
+        if m < 2 * MIN_SIDE {
+            return None;
+        }
+        let sums = Sums::new(prof);
+        let line = |lo: usize, hi: usize| sums.line(lo, hi);
+        let k = level_split(prof, &sums)?;
+        let toe = 0.5 * (prof[k - 1].0 + prof[k].0);
+        const NEAR_M: f64 = SPLIT_NEAR_M;
         if prof[k].0 - prof[k - 1].0 > 2.0 * NEAR_M || toe.abs() > half_w - NEAR_M {
             return None;
         }
@@ -243,6 +270,62 @@ impl Profile<'_> {
             first_high: prof[k].0,
         })
     }
+}
+
+/// The median of `v` as [`super::median`] gives it, by selection rather than a sort (`v` is
+/// reordered); `None` when empty.
+fn select_median(v: &mut [f64]) -> Option<f64> {
+    let (n, m) = (v.len(), v.len() / 2);
+    if n == 0 {
+        return None;
+    }
+    let (lower, mid, _) = v.select_nth_unstable_by(m, |a, b| a.total_cmp(b));
+    let mid = *mid;
+    Some(if n % 2 == 1 {
+        mid
+    } else {
+        let below = lower.iter().copied().max_by(|a, b| a.total_cmp(b))?;
+        0.5 * (below + mid)
+    })
+}
+
+/// Fewest points on each side of [`Profile::toe`]'s split.
+const SPLIT_MIN_SIDE: usize = 4;
+
+/// Farthest from [`Profile::toe`]'s toe that the nearest road and curb points may lie,
+/// metres (ground seen right beside the toe).
+const SPLIT_NEAR_M: f64 = 0.15;
+
+/// The best split k of `prof` (sorted by `across`; `sums` its running sums) into two levels,
+/// `prof[..k]` the road and `prof[k..]` the curb, each of at least [`SPLIT_MIN_SIDE`] points,
+/// by the least squared deviation from the two levels; `None` where there is none. Points on
+/// the curb face go to the nearer level, so the split falls at the face's middle.
+fn level_split(prof: &[(f64, f64, f64)], sums: &Sums) -> Option<usize> {
+    let m = prof.len();
+    if m < 2 * SPLIT_MIN_SIDE {
+        return None;
+    }
+    let acc = &sums.acc;
+    // Σ(z − mean)² over prof[lo..hi].
+    let level_sse = |lo: usize, hi: usize| {
+        let (n, sz, szz) = (
+            (hi - lo) as f64,
+            acc[hi][3] - acc[lo][3],
+            acc[hi][5] - acc[lo][5],
+        );
+        (szz - sz * sz / n).max(0.0)
+    };
+    let mut best: Option<(f64, usize)> = None;
+    for k in SPLIT_MIN_SIDE..=m - SPLIT_MIN_SIDE {
+        if prof[k].0 - prof[k - 1].0 <= 0.0 {
+            continue; // a split must fall between two distinct positions
+        }
+        let e = level_sse(0, k) + level_sse(k, m);
+        if best.is_none_or(|(be, _)| e < be) {
+            best = Some((e, k));
+        }
+    }
+    best.map(|(_, k)| k)
 }
 
 /// A thread's buffers for [`Profile::gather`]: the points as the grid hands them over and the sort's
@@ -566,6 +649,70 @@ mod tests {
         // A road rising 12 % to the toe, or falling 20 %, is no curb's road.
         assert!(toe_beside(|x| 0.12 * x + 0.05, &params).is_none());
         assert!(toe_beside(|x| -0.2 * x, &params).is_none());
+    }
+
+    /// [`Profile::toe_or_past_face`] on a profile across a curb along y
+    /// (towards +x), its returns in columns across at `(x, z)`, five along each (every
+    /// 0.12 m), as a far curb's returns lie.
+    fn columns(cols: &[(f64, f64)]) -> (Option<ProfileToe>, Option<ProfileToe>) {
+        let (mut x, mut y, mut z) = (Vec::new(), Vec::new(), Vec::new());
+        for &(cx, cz) in cols {
+            for j in -2..=2 {
+                x.push(cx);
+                y.push(0.12 * f64::from(j));
+                z.push(cz);
+            }
+        }
+        let points = KeptPoints::new(x, y, z);
+        let trajectory = Trajectory::default();
+        let input = points.input(&trajectory);
+        let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
+        let params = BendParams::default();
+        let profile = Profile {
+            input: &input,
+            grid: &grid,
+            params: &params,
+            centre: [0.0, 0.0, 0.0],
+            along: [0.0, 1.0],
+            up: -1.0,
+            half_l: 0.3,
+        };
+        profile.toe_or_past_face()
+    }
+
+    #[test]
+    fn a_sparse_curb_with_a_return_on_its_face_shows_its_toe_past_the_face() {
+        // An 80 mm curb at x = 0: road columns 0.22 m apart, one column on the face 30 mm
+        // up, the top's columns beyond.
+        let face = [
+            (-0.40, 0.0),
+            (-0.18, 0.0),
+            (0.01, 0.03),
+            (0.06, 0.08),
+            (0.28, 0.0856),
+        ];
+        let (toe, past) = columns(&face);
+        assert!(toe.is_none(), "{toe:?}");
+        let past = past.expect("a toe past the face");
+        assert!(past.xyz[0].abs() < 0.1, "{past:?}");
+        assert!((past.step_m - 0.08).abs() < 0.02, "{past:?}");
+        // The same curb without the face's column: `toe` finds it.
+        let plain: Vec<(f64, f64)> = face.iter().copied().filter(|c| c.1 != 0.03).collect();
+        let (toe, past) = columns(&plain);
+        assert!(toe.is_some() && past.is_none(), "{toe:?} {past:?}");
+        // A ramp rising 80 mm over 0.6 m (a curb cut's) and a lone mid-height column
+        // between columns 0.23 m apart are no curb.
+        let ramp = [
+            (-0.40, 0.0),
+            (-0.18, 0.0),
+            (0.0, 0.02),
+            (0.15, 0.04),
+            (0.30, 0.06),
+            (0.42, 0.08),
+        ];
+        assert_eq!(columns(&ramp), (None, None));
+        let wide = [(-0.40, 0.0), (-0.18, 0.0), (0.05, 0.04), (0.28, 0.08)];
+        assert_eq!(columns(&wide), (None, None));
     }
 
     /// `sort_across(prof)` against the standard library's stable sort by `total_cmp`, bit

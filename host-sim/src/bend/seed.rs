@@ -14,7 +14,7 @@ use super::arc_seed::{arc_params, arc_seed};
 use super::face::face_toe_or_longer;
 use super::grid::PointGrid;
 use super::params::{widened, BendParams};
-use super::profile::{usable, Profile};
+use super::profile::{usable, Profile, ProfileToe};
 use super::route::Route;
 use super::BendInput;
 use crate::model::Side;
@@ -125,6 +125,12 @@ const SPARSE_LENGTH_FACTOR: f64 = 2.0;
 /// side (the tracker's `profile::Profile::toe_or_longer` does the same). Short stretches
 /// of curb seen between parked vehicles are then seeded as well.
 ///
+/// Where none finds a toe, the first toe the three searches find with the points on the
+/// curb's face left out (`profile::Profile::toe_or_past_face`, on the points each profile
+/// gathered) gives the seed: on a far curb the returns lie a decimetre or two apart
+/// across, and one on the face, half-way up the step, tilts the road's or the top's line
+/// so that no profile shows the curb.
+///
 /// Where none finds a toe either, profiles turned towards a corner arc's direction are
 /// tried ([`arc_seed`]): an arc whose curb before it is never seen is reached by no track.
 ///
@@ -171,13 +177,11 @@ pub fn profile_seeds(
             .flat_map_iter(|&l| sides.iter().map(move |&s| (l, s)))
             .filter_map(|((interval, p, fwd), (side, up))| {
                 let n = [-fwd[1] * up, fwd[0] * up];
-                let mut heights = Heights::new(params.profile_half_width_m);
-                let mut first = |params: &BendParams, half_l: f64, along: [f64; 2]| {
+                let mut heights = Heights::default();
+                let mut first = |params: &BendParams, half_l: f64, along: [f64; 2], toe: ToeOn| {
                     let h = &mut heights;
                     let range = (PROFILE_SEED_NEAR_M, reach);
-                    first_toe_outward(
-                        input, grid, p, along, n, up, half_l, range, false, params, h,
-                    )
+                    first_toe_outward(input, grid, p, along, n, up, half_l, range, toe, params, h)
                 };
                 let seed = |point| Seed {
                     point,
@@ -186,18 +190,28 @@ pub fn profile_seeds(
                     interval,
                     inlier_ratio: 0.0,
                 };
-                first(params, half_l, fwd)
-                    .or_else(|| first(&wide, half_l, fwd))
-                    .or_else(|| first(params, SPARSE_LENGTH_FACTOR * half_l, fwd))
-                    .map(seed)
-                    .or_else(|| {
-                        arc_seed(fwd, |along| first(&arc, half_l, along)).map(|(point, along)| {
-                            Seed {
-                                dir: along,
-                                ..seed(point)
-                            }
-                        })
-                    })
+                // The default, widened and longer searches in turn; the first toe past a
+                // face (in the same order) where none finds a toe.
+                let past_face: ToeOn = |profile| profile.toe_or_past_face();
+                let long = SPARSE_LENGTH_FACTOR * half_l;
+                let (mut found, mut face) = (None, None);
+                for (params, half_l) in [(params, half_l), (&wide, half_l), (params, long)] {
+                    let (toe, past) = first(params, half_l, fwd, past_face);
+                    if toe.is_some() {
+                        found = toe;
+                        break;
+                    }
+                    face = face.or(past);
+                }
+                let toe: ToeOn = |profile| (profile.toe(), None);
+                found.or(face).map(seed).or_else(|| {
+                    arc_seed(fwd, |along| first(&arc, half_l, along, toe).0).map(
+                        |(point, along)| Seed {
+                            dir: along,
+                            ..seed(point)
+                        },
+                    )
+                })
             }),
     );
     out
@@ -216,26 +230,18 @@ pub(super) fn finite_range(t: &[f64]) -> Option<(f64, f64)> {
 }
 
 /// The ground heights ([`ground_height`]) at the centres of one side's outward search,
-/// kept for the searches after it: the centres are the same in every search, and the
-/// profiles of the default width and the longer ones take their heights over the same
-/// radius (`r`); a search of another radius (the widened profiles') computes its own.
+/// kept for the searches after it: the centres are the same in every search, and each
+/// radius (the default profiles' and the longer ones', the widened ones', the turned ones')
+/// has its own heights.
+#[derive(Default)]
 struct Heights {
-    r: f64,
-    /// By centre, counted outward: `None` where not yet computed.
-    z: Vec<Option<Option<f64>>>,
+    /// By radius (its bits), then by centre counted outward: `None` where not yet computed.
+    z: Vec<(u64, Vec<Option<Option<f64>>>)>,
     /// The heights within the radius, kept from one centre to the next.
     scratch: Vec<i64>,
 }
 
 impl Heights {
-    fn new(r: f64) -> Self {
-        Self {
-            r,
-            z: Vec::new(),
-            scratch: Vec::new(),
-        }
-    }
-
     /// [`ground_height`] at centre `k` (counted outward) within `r` of `centre`.
     fn at(
         &mut self,
@@ -245,21 +251,31 @@ impl Heights {
         centre: [f64; 2],
         r: f64,
     ) -> Option<f64> {
-        if r.to_bits() != self.r.to_bits() {
-            return ground_height(input, grid, centre, r, &mut self.scratch);
+        let bits = r.to_bits();
+        let slot = match self.z.iter().position(|s| s.0 == bits) {
+            Some(slot) => slot,
+            None => {
+                self.z.push((bits, Vec::new()));
+                self.z.len() - 1
+            }
+        };
+        let (z, scratch) = (&mut self.z[slot].1, &mut self.scratch);
+        if z.len() <= k {
+            z.resize(k + 1, None);
         }
-        if self.z.len() <= k {
-            self.z.resize(k + 1, None);
-        }
-        *self.z[k].get_or_insert_with(|| ground_height(input, grid, centre, r, &mut self.scratch))
+        *z[k].get_or_insert_with(|| ground_height(input, grid, centre, r, scratch))
     }
 }
 
+/// A toe search on one profile: its toe, else a fallback toe of a lower rank (one found
+/// past the curb's face).
+type ToeOn = fn(&Profile) -> (Option<ProfileToe>, Option<ProfileToe>);
+
 /// The seed point of the first toe that profiles across `fwd` find outward along `n` from
 /// `p`, from `near` to `reach` every [`PROFILE_SEED_STEP_M`] (see [`profile_seeds`]), by
-/// `profile::Profile::toe`, else `face::face_toe_or_longer` when `ring`: the usable point nearest to it;
-/// `None` where the first toe has none within the search radius, or there is no toe. The
-/// ground heights come from `heights`.
+/// `toe_on` on each profile: the usable point nearest to it, `None` where the first toe has
+/// none within the search radius, or there is no toe; and where there is no toe, the seed
+/// point of the first fallback toe the same way. The ground heights come from `heights`.
 #[allow(clippy::too_many_arguments)]
 fn first_toe_outward(
     input: &BendInput,
@@ -270,10 +286,11 @@ fn first_toe_outward(
     up: f64,
     half_l: f64,
     (near, reach): (f64, f64),
-    ring: bool,
+    toe_on: ToeOn,
     params: &BendParams,
     heights: &mut Heights,
-) -> Option<u32> {
+) -> (Option<u32>, Option<u32>) {
+    let mut fallback = None;
     let mut c = near;
     let mut k = 0;
     while c <= reach {
@@ -293,17 +310,15 @@ fn first_toe_outward(
             up,
             half_l,
         };
-        let toe = if ring {
-            profile.toe().or_else(|| face_toe_or_longer(&profile))
-        } else {
-            profile.toe()
-        };
-        let Some(toe) = toe else {
-            continue;
-        };
-        return nearest_usable(input, grid, toe.xyz, params.search_radius_m);
+        let (toe, past) = toe_on(&profile);
+        if let Some(toe) = toe {
+            let point = nearest_usable(input, grid, toe.xyz, params.search_radius_m);
+            return (point, None);
+        }
+        fallback = fallback.or(past);
     }
-    None
+    let point = fallback.and_then(|t| nearest_usable(input, grid, t.xyz, params.search_radius_m));
+    (None, point)
 }
 
 /// Seeds from radial profiles at the two ends of the input's points, for a spinning
@@ -365,10 +380,13 @@ pub fn end_seeds(
             // Across the profile runs along the ray, away from the sensor (`up` = +1).
             let along = [ray[1], -ray[0]];
             let range = (view.near_m, view.reach_m);
-            let h = &mut Heights::new(params.profile_half_width_m);
+            let h = &mut Heights::default();
+            let toe: ToeOn =
+                |profile| (profile.toe().or_else(|| face_toe_or_longer(profile)), None);
             let point = first_toe_outward(
-                input, grid, p, along, ray, 1.0, half_l, range, true, params, h,
-            )?;
+                input, grid, p, along, ray, 1.0, half_l, range, toe, params, h,
+            )
+            .0?;
             let i = point as usize;
             let (dx, dy) = (input.x[i] - p[0], input.y[i] - p[1]);
             let side = if fwd[0] * dy - fwd[1] * dx >= 0.0 {
@@ -705,10 +723,11 @@ mod tests {
                     1.0,
                     half_l,
                     (PROFILE_SEED_NEAR_M, 15.0),
-                    false,
+                    |profile| (profile.toe(), None),
                     p,
-                    &mut Heights::new(params.profile_half_width_m),
-                );
+                    &mut Heights::default(),
+                )
+                .0;
                 assert_eq!(toe, None, "a toe at {at:?}");
             }
         }
@@ -772,10 +791,11 @@ mod tests {
                     1.0,
                     l,
                     (PROFILE_SEED_NEAR_M, 15.0),
-                    false,
+                    |profile| (profile.toe(), None),
                     p,
-                    &mut Heights::new(params.profile_half_width_m),
-                );
+                    &mut Heights::default(),
+                )
+                .0;
                 assert_eq!(toe, None, "a toe at {at:?}");
             }
         }
