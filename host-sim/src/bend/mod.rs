@@ -20,6 +20,7 @@ pub mod face;
 pub mod flush;
 pub mod grid;
 pub mod hole;
+pub mod hook;
 pub mod leg;
 pub mod leg_screen;
 pub mod leg_seed;
@@ -205,6 +206,8 @@ pub fn extract_edges_on_grid(
     let tracks = bridge::bridge_tracks(&input, grid, tracks, next_id, params);
     // Runs of flush toes go back on the ends no bridge continues.
     let tracks = track::attach_tails(tracks, tails);
+    // Turns off the curb along a parked vehicle's end go (filter 2c).
+    let tracks = hook::remove_vehicle_hooks(&input, grid, route, tracks, params);
     postfilter::to_edge_lines_with_steps(&input, grid, route, &tracks, params)
 }
 

@@ -400,7 +400,7 @@ pub fn remove_outside_roadway(_input: &BendInput, route: &Route, tracks: Vec<Tra
 }
 
 /// Unit tangent of a track at vertex `k`, over the vertices within `half_span_m` of it.
-fn tangent(xy: &[[f64; 2]], k: usize, half_span_m: f64) -> Option<[f64; 2]> {
+pub(super) fn tangent(xy: &[[f64; 2]], k: usize, half_span_m: f64) -> Option<[f64; 2]> {
     let mut a = k;
     while a > 0 && (xy[a - 1][0] - xy[k][0]).hypot(xy[a - 1][1] - xy[k][1]) <= half_span_m {
         a -= 1;
