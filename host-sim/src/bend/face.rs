@@ -190,7 +190,7 @@ pub fn face_toe_or_longer(profile: &Profile) -> Option<ProfileToe> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bend::fixture::KeptPoints;
+    use crate::bend::fixture::{profile_along_y, KeptPoints};
     use crate::bend::grid::PointGrid;
     use crate::bend::params::BendParams;
     use crate::io::trajectory::Trajectory;
@@ -232,15 +232,13 @@ mod tests {
         let input = points.input(&trajectory);
         let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
         let params = BendParams::default();
-        let profile = Profile {
-            input: &input,
-            grid: &grid,
-            params: &params,
-            centre: [0.0, 0.0, 0.0],
-            along: [0.0, 1.0],
-            up: -1.0,
-            half_l: params.profile_half_length_m,
-        };
+        let profile = profile_along_y(
+            &input,
+            &grid,
+            &params,
+            [0.0, 0.0, 0.0],
+            params.profile_half_length_m,
+        );
         (profile.toe_or_longer(), face_toe_or_longer(&profile))
     }
 
@@ -276,15 +274,13 @@ mod tests {
         let input = points.input(&trajectory);
         let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
         let params = BendParams::default();
-        let profile = Profile {
-            input: &input,
-            grid: &grid,
-            params: &params,
-            centre: [0.0, 0.0, 0.0],
-            along: [0.0, 1.0],
-            up: -1.0,
-            half_l: params.profile_half_length_m,
-        };
+        let profile = profile_along_y(
+            &input,
+            &grid,
+            &params,
+            [0.0, 0.0, 0.0],
+            params.profile_half_length_m,
+        );
         assert!(face_toe_or_longer(&profile).is_none());
     }
 }

@@ -1,8 +1,12 @@
-//! Point columns for the unit tests of the bend modules: every point kept by the core with
-//! no bend angle, borrowed as a [`BendInput`] with no candidates.
+//! Point columns, a straight drive and a profile for the unit tests of the bend modules:
+//! every point kept by the core with no bend angle, borrowed as a [`BendInput`] with no
+//! candidates.
 
+use super::grid::PointGrid;
+use super::params::BendParams;
+use super::profile::Profile;
 use super::BendInput;
-use crate::io::trajectory::Trajectory;
+use crate::io::trajectory::{Pose, Trajectory};
 use crate::replay::PointStatus;
 
 /// The columns a test's [`BendInput`] borrows. `t` and `scanline` are zero unless a test
@@ -49,5 +53,41 @@ impl KeptPoints {
             candidates: &[],
             trajectory,
         }
+    }
+}
+
+/// A drive east along y = 0 at 10 m/s, 2 m up, from x = −10 to 40 m (time `t0` at x = 0).
+pub(super) fn drive_along_x(t0: f64) -> Trajectory {
+    let samples = (-10..=40)
+        .map(|k| Pose {
+            t: t0 + 0.1 * f64::from(k),
+            x: f64::from(k),
+            y: 0.0,
+            z: 2.0,
+            roll_deg: 0.0,
+            pitch_deg: 0.0,
+            heading_deg: 90.0,
+        })
+        .collect();
+    Trajectory { samples }
+}
+
+/// The profile through `centre` along +y, `half_l` either side, the curb rising towards +x
+/// (`up` = −1).
+pub(super) fn profile_along_y<'a>(
+    input: &'a BendInput<'a>,
+    grid: &'a PointGrid,
+    params: &'a BendParams,
+    centre: [f64; 3],
+    half_l: f64,
+) -> Profile<'a> {
+    Profile {
+        input,
+        grid,
+        params,
+        centre,
+        along: [0.0, 1.0],
+        up: -1.0,
+        half_l,
     }
 }

@@ -226,7 +226,7 @@ impl Profile<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bend::fixture::KeptPoints;
+    use crate::bend::fixture::{profile_along_y, KeptPoints};
     use crate::bend::grid::PointGrid;
     use crate::bend::params::BendParams;
     use crate::io::trajectory::Trajectory;
@@ -282,15 +282,7 @@ mod tests {
             let trajectory = Trajectory::default();
             let input = p.input(&trajectory);
             let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
-            let prof = Profile {
-                input: &input,
-                grid: &grid,
-                params: &params,
-                centre: [0.0, 0.0, 0.0],
-                along: [0.0, 1.0],
-                up: -1.0,
-                half_l: 0.3,
-            };
+            let prof = profile_along_y(&input, &grid, &params, [0.0, 0.0, 0.0], 0.3);
             assert!(prof.cut_toe().is_none());
         }
     }

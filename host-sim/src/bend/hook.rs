@@ -165,25 +165,8 @@ pub fn remove_vehicle_hooks(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bend::fixture::KeptPoints;
-    use crate::io::trajectory::{Pose, Trajectory};
+    use crate::bend::fixture::{drive_along_x, KeptPoints};
     use crate::model::Side;
-
-    /// A drive along +x, 2 m up, from x = −10 to 40 m.
-    fn along_x() -> Trajectory {
-        let samples = (-10..=40)
-            .map(|k| Pose {
-                t: 0.1 * f64::from(k),
-                x: f64::from(k),
-                y: 0.0,
-                z: 2.0,
-                roll_deg: 0.0,
-                pitch_deg: 0.0,
-                heading_deg: 90.0,
-            })
-            .collect();
-        Trajectory { samples }
-    }
 
     /// Vertices 0.1 m apart on the road's level from `a` to `b`.
     fn run(a: [f64; 2], b: [f64; 2]) -> Vec<[f64; 3]> {
@@ -220,7 +203,7 @@ mod tests {
             }
         }
         let points = KeptPoints::new(x, y, z);
-        let traj = along_x();
+        let traj = drive_along_x(0.0);
         let input = points.input(&traj);
         let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
         let route = Route::new(&traj);
@@ -263,7 +246,7 @@ mod tests {
             }
         }
         let points = KeptPoints::new(x, y, z);
-        let traj = along_x();
+        let traj = drive_along_x(0.0);
         let input = points.input(&traj);
         let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
         let route = Route::new(&traj);
@@ -296,7 +279,7 @@ mod tests {
             }
         }
         let points = KeptPoints::new(x, y, z);
-        let traj = along_x();
+        let traj = drive_along_x(0.0);
         let input = points.input(&traj);
         let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
         let route = Route::new(&traj);

@@ -98,7 +98,7 @@ pub fn leg_toe(profile: &Profile, picked: &[(u32, [f64; 3])]) -> Option<ProfileT
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bend::fixture::KeptPoints;
+    use crate::bend::fixture::{profile_along_y, KeptPoints};
     use crate::bend::grid::PointGrid;
     use crate::bend::params::BendParams;
     use crate::io::trajectory::Trajectory;
@@ -146,15 +146,13 @@ mod tests {
         let input = pts.input(&traj);
         let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
         let params = BendParams::default();
-        let profile = Profile {
-            input: &input,
-            grid: &grid,
-            params: &params,
-            centre: [0.0, 0.3, 0.0],
-            along: [0.0, 1.0],
-            up: -1.0,
-            half_l: params.profile_half_length_m,
-        };
+        let profile = profile_along_y(
+            &input,
+            &grid,
+            &params,
+            [0.0, 0.3, 0.0],
+            params.profile_half_length_m,
+        );
         (profile.toe_or_longer(), leg_toe(&profile, &picked))
     }
 

@@ -215,9 +215,8 @@ pub fn leg_seeds(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bend::fixture::KeptPoints;
+    use crate::bend::fixture::{drive_along_x, KeptPoints};
     use crate::bend::seed::profile_seeds;
-    use crate::io::trajectory::{Pose, Trajectory};
 
     /// A side street's leg left of a drive east along y = 0: the road level west of
     /// x = 10 m, the sidewalk 0.12 m up east of it, from y = 3 m to 12 m aside, sampled on a
@@ -245,18 +244,7 @@ mod tests {
             t,
             ..KeptPoints::new(x, y, z)
         };
-        let samples = (-10..=40)
-            .map(|k| Pose {
-                t: T0 + 0.1 * f64::from(k),
-                x: f64::from(k),
-                y: 0.0,
-                z: 2.0,
-                roll_deg: 0.0,
-                pitch_deg: 0.0,
-                heading_deg: 90.0,
-            })
-            .collect();
-        let trajectory = Trajectory { samples };
+        let trajectory = drive_along_x(T0);
         let input = points.input(&trajectory);
         let params = BendParams::default();
         let grid = PointGrid::build(input.x, input.y, params.search_radius_m, |_| true);

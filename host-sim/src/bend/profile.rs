@@ -600,7 +600,7 @@ impl Profile<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bend::fixture::KeptPoints;
+    use crate::bend::fixture::{profile_along_y, KeptPoints};
     use crate::io::trajectory::Trajectory;
 
     /// The toe on a profile across a curb along y at x = 0 (0.15 m up towards +x, the
@@ -668,15 +668,7 @@ mod tests {
         let input = points.input(&trajectory);
         let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
         let params = BendParams::default();
-        let profile = Profile {
-            input: &input,
-            grid: &grid,
-            params: &params,
-            centre: [0.0, 0.0, 0.0],
-            along: [0.0, 1.0],
-            up: -1.0,
-            half_l: 0.3,
-        };
+        let profile = profile_along_y(&input, &grid, &params, [0.0, 0.0, 0.0], 0.3);
         profile.toe_or_past_face()
     }
 

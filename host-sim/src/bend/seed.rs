@@ -600,8 +600,7 @@ pub fn ransac_line(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bend::fixture::KeptPoints;
-    use crate::io::trajectory::{Pose, Trajectory};
+    use crate::bend::fixture::{drive_along_x, KeptPoints};
 
     #[test]
     fn end_rays_leave_no_stretch_within_the_reach_unseen() {
@@ -665,22 +664,6 @@ mod tests {
     /// apart across, each line's offset 2.25 cm past the one before, as on a curb its
     /// scanlines cross at a grazing angle. A profile 0.6 m long holds no return right beside
     /// the toe on one side; one 1.2 m long does.
-    /// A drive along +x at 10 m/s, 2 m up, from x = −10 to 40 m (time `t0` at x = 0).
-    fn along_x(t0: f64) -> Trajectory {
-        let samples = (-10..=40)
-            .map(|k| Pose {
-                t: t0 + 0.1 * f64::from(k),
-                x: f64::from(k),
-                y: 0.0,
-                z: 2.0,
-                roll_deg: 0.0,
-                pitch_deg: 0.0,
-                heading_deg: 90.0,
-            })
-            .collect();
-        Trajectory { samples }
-    }
-
     #[test]
     fn a_sparse_far_curb_is_seeded_from_longer_profiles() {
         const T0: f64 = 400_000_000.0;
@@ -704,7 +687,7 @@ mod tests {
             t,
             ..KeptPoints::new(x, y, z)
         };
-        let trajectory = along_x(T0);
+        let trajectory = drive_along_x(T0);
         let input = points.input(&trajectory);
         let params = BendParams::default();
         let grid = PointGrid::build(input.x, input.y, params.search_radius_m, |_| true);
@@ -768,7 +751,7 @@ mod tests {
             t,
             ..KeptPoints::new(x, y, z)
         };
-        let trajectory = along_x(T0);
+        let trajectory = drive_along_x(T0);
         let input = points.input(&trajectory);
         let params = BendParams::default();
         let grid = PointGrid::build(input.x, input.y, params.search_radius_m, |_| true);

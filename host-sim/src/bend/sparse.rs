@@ -368,6 +368,7 @@ fn step_across(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bend::fixture::profile_along_y;
     use crate::io::trajectory::{Pose, Trajectory};
     use crate::replay::PointStatus;
 
@@ -467,15 +468,7 @@ mod tests {
         let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
         let params = BendParams::default();
         // Along +y, the curb rising to the right (x > 0): up = −1.
-        let profile = Profile {
-            input: &input,
-            grid: &grid,
-            params: &params,
-            centre: [centre_x, 0.0, 0.0],
-            along: [0.0, 1.0],
-            up: -1.0,
-            half_l: 0.3,
-        };
+        let profile = profile_along_y(&input, &grid, &params, [centre_x, 0.0, 0.0], 0.3);
         sparse_toe(&profile, &l.picked)
     }
 
