@@ -311,16 +311,6 @@ const DIR_BASE_M: f64 = 0.5;
 /// profile is asked instead, metres: 0.15 m apart on a 10 % grade they differ by 15 mm.
 const MAX_TOE_DZ_M: f64 = 0.04;
 
-/// Farthest a pick by ρ may lie across the line of the track's last metres
-/// ([`line_ahead`]) before the virtual profile is asked instead, metres: beyond the
-/// picks' scatter across the toe (the point spacing along the scanlines, ±4 cm at worst).
-const STRAY_M: f64 = 0.05;
-
-/// Share of a stray pick's distance across the track's line that the virtual profile's toe
-/// must stay within to replace it: on a true bend of the curb the profile's toe leaves the
-/// line as far as the pick does, and the pick stands.
-const STRAY_KEEP: f64 = 0.5;
-
 /// Vertices a track must have before it may follow a curb cut's toe
 /// ([`Profile::cut_toe`]): 1.5 m of curb, so that the break of slope is only ever followed
 /// along a line already tracked.
@@ -830,16 +820,6 @@ fn track_one_way(
             // noisy), so the virtual profile's toe is taken instead when there is one.
             let jumped = (input.z[n] - cur[2]).abs() > MAX_TOE_DZ_M;
             let along = [vh[0] / vh_len, vh[1] / vh_len];
-            // A pick well across the line of the track's last metres is road noise beside
-            // the toe (its ρ peaks there over a few scanlines, and Eq. 8 turns the search
-            // after it) where a virtual profile finds the toe on that line.
-            let across_line = line_ahead(&picked, cur, along, d_s).map(|(q, a)| {
-                move |p: [f64; 3]| ((p[0] - q[0]) * a[1] - (p[1] - q[1]) * a[0]).abs()
-            });
-            let pick_off = across_line
-                .as_ref()
-                .map_or(0.0, |f| f([input.x[n], input.y[n], 0.0]));
-            let strayed = pick_off > STRAY_M;
             let c = [pred[0], pred[1], cur[2]];
             let l = params.profile_half_length_m;
             let profile = Profile {
@@ -852,17 +832,11 @@ fn track_one_way(
                 half_l: l,
             };
             let long = profile.with_half_l(2.0 * l);
-            match ((jumped || strayed) && params.profile_fallback && *next_virtual < u32::MAX)
+            match (jumped && params.profile_fallback && *next_virtual < u32::MAX)
                 .then(|| profile.toe_or_longer())
                 .flatten()
                 .filter(|t| {
                     (t.xyz[0] - cur[0]) * along[0] + (t.xyz[1] - cur[1]) * along[1] > 0.25 * d_s
-                })
-                .filter(|t| {
-                    jumped
-                        || across_line
-                            .as_ref()
-                            .is_some_and(|f| f(t.xyz) <= STRAY_KEEP * pick_off)
                 }) {
                 Some(toe) => {
                     weak_run_m = 0.0;
@@ -1264,37 +1238,6 @@ mod tests {
         let low = weak_line(12.0, 15.0);
         let far_low = farthest_x(&low, &params);
         assert!((11.7..12.5).contains(&far_low), "weak curb: x = {far_low}");
-    }
-
-    #[test]
-    fn a_pick_that_strays_across_the_tracks_line_gives_way_to_the_profiles_toe() {
-        // The curb of `weak_line`, with road noise whose ρ (60°) outdoes the toe's (40°)
-        // on a line leaving the toe towards the road at 1 in 3 from x = 5 to x = 6
-        // (0.33 m off at its end): the energy of Eq. 4-8 walks the track along it, while
-        // the virtual profile still finds the toe on the track's line.
-        let mut c = weak_line(16.0, 60.0);
-        let mut noise = 0;
-        for i in 0..c.x.len() {
-            let x = c.x[i];
-            if !(5.0..6.0).contains(&x) {
-                continue;
-            }
-            if c.rho[i] > 0.0 {
-                c.rho[i] = 40.0;
-            }
-            let noise_y = 4.99 - (x - 5.0) / 3.0;
-            if (c.y[i] - noise_y).abs() < 0.01 && noise_y < 4.97 {
-                c.rho[i] = 60.0;
-                noise += 1;
-            }
-        }
-        assert!(noise >= 8, "{noise} noise points");
-        let t = track(&c, &BendParams::default());
-        let far = t.xyz.iter().map(|q| q[0]).fold(f64::MIN, f64::max);
-        assert!(far > 15.0, "stopped at x = {far}");
-        for q in &t.xyz {
-            assert!((q[1] - 5.0).abs() < 0.06, "vertex {q:?} off the toe");
-        }
     }
 
     #[test]
