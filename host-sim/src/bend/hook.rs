@@ -188,6 +188,16 @@ mod tests {
         }
     }
 
+    /// `remove_vehicle_hooks` with the defaults on `tracks` beside `points`, along a drive
+    /// east along y = 0.
+    fn without_hooks(points: &KeptPoints, tracks: Vec<Track>) -> Vec<Track> {
+        let traj = drive_along_x(0.0);
+        let input = points.input(&traj);
+        let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
+        let route = Route::new(&traj);
+        remove_vehicle_hooks(&input, &grid, &route, tracks, &BendParams::default())
+    }
+
     #[test]
     fn a_turn_along_a_vehicles_end_is_cut_and_a_corner_stays() {
         // A curb 3 m left of the drive from x = 0 to 10; a car parked on the road beyond
@@ -203,17 +213,12 @@ mod tests {
             }
         }
         let points = KeptPoints::new(x, y, z);
-        let traj = drive_along_x(0.0);
-        let input = points.input(&traj);
-        let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
-        let route = Route::new(&traj);
-        let p = BendParams::default();
         let hooked: Vec<[f64; 3]> = run([0.0, 3.0], [10.0, 3.0])
             .into_iter()
             .chain(run([10.0, 3.0], [10.0, 1.0]))
             .chain(run([10.0, 1.0], [15.0, 1.0]))
             .collect();
-        let kept = remove_vehicle_hooks(&input, &grid, &route, vec![track(hooked.clone())], &p);
+        let kept = without_hooks(&points, vec![track(hooked.clone())]);
         assert_eq!(kept.len(), 2, "{kept:?}");
         // Nothing of the turn is left: every vertex lies along the drive, on the curb or
         // the car's side, within the tangent's half-span of the corner.
@@ -226,9 +231,7 @@ mod tests {
         assert!(kept[0].xyz.iter().all(|q| q[1] == 3.0) && kept[0].xyz.len() > 90);
         // The same turn with no vehicle beside it (a side street's corner) stays whole.
         let bare = KeptPoints::new(vec![], vec![], vec![]);
-        let input = bare.input(&traj);
-        let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
-        let kept = remove_vehicle_hooks(&input, &grid, &route, vec![track(hooked.clone())], &p);
+        let kept = without_hooks(&bare, vec![track(hooked.clone())]);
         assert_eq!(kept, vec![track(hooked)]);
     }
 
@@ -246,10 +249,6 @@ mod tests {
             }
         }
         let points = KeptPoints::new(x, y, z);
-        let traj = drive_along_x(0.0);
-        let input = points.input(&traj);
-        let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
-        let route = Route::new(&traj);
         let jog = track(
             run([0.0, 3.0], [10.0, 3.0])
                 .into_iter()
@@ -257,13 +256,7 @@ mod tests {
                 .chain(run([10.0, 1.8], [15.0, 1.8]))
                 .collect(),
         );
-        let kept = remove_vehicle_hooks(
-            &input,
-            &grid,
-            &route,
-            vec![jog.clone()],
-            &BendParams::default(),
-        );
+        let kept = without_hooks(&points, vec![jog.clone()]);
         assert_eq!(kept, vec![jog]);
     }
 
@@ -279,18 +272,8 @@ mod tests {
             }
         }
         let points = KeptPoints::new(x, y, z);
-        let traj = drive_along_x(0.0);
-        let input = points.input(&traj);
-        let grid = PointGrid::build(input.x, input.y, 0.1, |_| true);
-        let route = Route::new(&traj);
         let curb = track(run([0.0, 3.0], [5.0, 3.0]));
-        let kept = remove_vehicle_hooks(
-            &input,
-            &grid,
-            &route,
-            vec![curb.clone()],
-            &BendParams::default(),
-        );
+        let kept = without_hooks(&points, vec![curb.clone()]);
         assert_eq!(kept, vec![curb]);
     }
 }
